@@ -1,0 +1,3 @@
+// PLACEHOLDER: replaced by the real command.
+#include "commands.hpp"
+namespace isohex::cli { void register_volume_molecule(CLI::App&) {} }

@@ -1,0 +1,51 @@
+#pragma once
+// Each subcommand lives in its own file and registers itself on the root CLI::App.
+// A registered callback runs the command; errors propagate as isohex::Error and main()
+// prints them and exits non-zero.
+
+#include <CLI/CLI.hpp>
+
+namespace isohex::cli {
+
+void register_quality(CLI::App& app);
+void register_check(CLI::App& app);
+void register_convert(CLI::App& app);
+void register_generate(CLI::App& app);
+
+/// The exit code a command asks for (0 unless a command reports a failed check).
+int& exit_code();
+
+}  // namespace isohex::cli
+
+#include "isohex/mesh/hex_mesh.hpp"
+
+#include <string>
+
+namespace isohex::cli {
+
+/// Reads a mesh for a command; prints how many non-hex cells were dropped, if any.
+HexMesh load_mesh(const std::string& file, bool skip_non_hex);
+
+/// Adds `--threads N` (0 = all cores) and returns where its value goes.
+int* add_threads_option(CLI::App* cmd);
+
+/// Limits oneTBB to `threads` workers for the lifetime of the returned object (0 = no limit).
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads);
+  ~ThreadLimit();
+  ThreadLimit(const ThreadLimit&) = delete;
+  ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+ private:
+  void* control_ = nullptr;
+};
+
+}  // namespace isohex::cli
+
+namespace isohex::cli {
+/// `isohex volume`: creates the group and adds info/convert, then the two below.
+void register_volume(CLI::App& app);
+void register_volume_molecule(CLI::App& volume);
+void register_volume_shape(CLI::App& volume);
+}  // namespace isohex::cli

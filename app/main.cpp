@@ -1,0 +1,39 @@
+// isohex command-line tool: one subcommand per stage.
+#include "commands.hpp"
+
+#include "isohex/error.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <exception>
+
+namespace isohex::cli {
+int& exit_code() {
+  static int code = 0;
+  return code;
+}
+}  // namespace isohex::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"isohex: all-hexahedral meshes from volumes, with verified element quality"};
+  app.set_version_flag("--version", "isohex 0.1.0");
+  app.require_subcommand(1);
+  isohex::cli::register_quality(app);
+  isohex::cli::register_check(app);
+  isohex::cli::register_convert(app);
+  isohex::cli::register_generate(app);
+  isohex::cli::register_volume(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const isohex::Error& e) {
+    fmt::print(stderr, "isohex: error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "isohex: internal error: {}\n", e.what());
+    return 3;
+  }
+  return isohex::cli::exit_code();
+}

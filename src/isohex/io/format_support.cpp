@@ -1,0 +1,66 @@
+#include "isohex/io/format_support.hpp"
+
+#include "isohex/error.hpp"
+
+#include <cmath>
+#include <ostream>
+
+namespace isohex::io {
+
+namespace {
+char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
+}  // namespace
+
+bool iequals(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (lower(a[i]) != lower(b[i])) return false;
+  return true;
+}
+
+bool istarts_with(std::string_view text, std::string_view prefix) {
+  return text.size() >= prefix.size() && iequals(text.substr(0, prefix.size()), prefix);
+}
+
+std::string printable(std::string_view token) {
+  constexpr std::size_t kMax = 40;
+  std::string out;
+  for (std::size_t i = 0; i < token.size() && i < kMax; ++i) {
+    const auto c = static_cast<unsigned char>(token[i]);
+    if (c >= 0x20 && c < 0x7f)
+      out += static_cast<char>(c);
+    else
+      out += fmt::format("\\x{:02x}", c);
+  }
+  if (token.size() > kMax) out += "...";
+  return out;
+}
+
+void check_mesh_for_writing(const std::filesystem::path& file, const HexMesh& mesh) {
+  const auto fail = [&](const std::string& what) {
+    throw Error(fmt::format("{}: cannot write: {}", file.string(), what));
+  };
+  const std::size_t nv = mesh.points.size();
+  if (!mesh.blocks.empty() && mesh.blocks.size() != mesh.hexes.size())
+    fail(fmt::format("the mesh has {} block ids for {} hexes", mesh.blocks.size(), mesh.hexes.size()));
+  if (!mesh.fixed.empty() && mesh.fixed.size() != nv)
+    fail(fmt::format("the mesh has {} fixed flags for {} vertices", mesh.fixed.size(), nv));
+  for (std::size_t v = 0; v < nv; ++v)
+    if (!mesh.points[v].allFinite()) fail(fmt::format("vertex {} has a non-finite coordinate", v));
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
+    for (const Index id : mesh.hexes[h])
+      if (id < 0 || static_cast<std::size_t>(id) >= nv)
+        fail(fmt::format("hex {} has vertex id {} out of range [0, {})", h, id, nv));
+}
+
+void TextOut::flush() {
+  out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  buffer_.clear();
+}
+
+void BigEndianOut::flush() {
+  out_.write(reinterpret_cast<const char*>(buffer_.data()), static_cast<std::streamsize>(buffer_.size()));
+  buffer_.clear();
+}
+
+}  // namespace isohex::io

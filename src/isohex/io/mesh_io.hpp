@@ -1,0 +1,64 @@
+#pragma once
+/// \file mesh_io.hpp
+/// \brief Reading and writing hex meshes, the format chosen by the file extension.
+///
+/// | extension      | format                                                        |
+/// |----------------|---------------------------------------------------------------|
+/// | `.vtk`         | legacy VTK UNSTRUCTURED_GRID, ASCII or BINARY, 4.2 and 5.1    |
+/// | `.vtu`         | VTK XML UnstructuredGrid: ascii, base64 inline, appended raw, zlib |
+/// | `.mesh`        | MEDIT / GMF ASCII (Vertices, Hexahedra, references)           |
+/// | `.inp`         | Abaqus input (C3D8, C3D8R)                                    |
+///
+/// Every reader throws isohex::Error naming the file, the place (line or byte offset) and
+/// the fault; it never crashes or hangs on malformed input, and refuses declared counts
+/// that the file cannot hold. Every writer writes to a temporary file beside the target
+/// and renames it into place, so a failed write leaves no half-written output.
+
+#include "isohex/mesh/hex_mesh.hpp"
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+
+namespace isohex::io {
+
+/// Options shared by all readers.
+struct ReadOptions {
+  /// Drop cells that are not linear hexahedra (and count them) instead of failing.
+  bool skip_non_hex = false;
+};
+
+/// What a reader noticed besides the mesh.
+struct ReadReport {
+  std::string format;               ///< e.g. "VTK legacy 5.1 binary"
+  std::size_t skipped_cells = 0;    ///< non-hex cells dropped under skip_non_hex
+};
+
+/// Options shared by all writers (each writer uses those that apply to it).
+struct WriteOptions {
+  bool binary = true;     ///< .vtk/.vtu: binary (exact) rather than ASCII (17 significant digits)
+  bool compress = true;   ///< .vtu: zlib-compress the appended data, as VTK does by default
+};
+
+/// Reads a mesh, choosing the reader by extension (case-insensitive).
+HexMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {},
+                  ReadReport* report = nullptr);
+
+/// Writes a mesh, choosing the writer by extension (case-insensitive).
+void write_mesh(const std::filesystem::path& file, const HexMesh& mesh,
+                const WriteOptions& options = {});
+
+/// True if the extension of `file` names a format read_mesh/write_mesh know.
+bool is_known_mesh_extension(const std::filesystem::path& file);
+
+// Per-format entry points (same contracts as above).
+HexMesh read_vtk_legacy(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
+void write_vtk_legacy(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
+HexMesh read_vtu(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
+void write_vtu(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
+HexMesh read_medit(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
+void write_medit(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
+HexMesh read_abaqus(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
+void write_abaqus(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
+
+}  // namespace isohex::io

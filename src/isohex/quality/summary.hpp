@@ -1,0 +1,70 @@
+#pragma once
+/// \file summary.hpp
+/// \brief Distribution of a metric over a mesh: extremes, mean, the scaled-Jacobian classes
+/// (inverted < 0, questionable < 0.2, degenerate), a histogram, and the worst elements.
+
+#include "isohex/quality/hex_quality.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace isohex {
+
+/// Threshold below which the paper (and isohex) calls an element questionable.
+inline constexpr double kQuestionableSJ = 0.2;
+
+/// True if larger values of `m` mean better elements.
+bool higher_is_better(HexMetric m);
+
+/// Counts in consecutive bins [edges[i], edges[i+1]) (the last bin includes its right edge).
+struct Histogram {
+  std::vector<double> edges;
+  std::vector<std::size_t> counts;
+  std::size_t below = 0;  ///< values below edges.front()
+  std::size_t above = 0;  ///< values above edges.back() (degenerate elements are not counted)
+};
+
+/// One element and its value.
+struct ElementValue {
+  Index id;
+  double value;
+};
+
+/// The distribution of one metric over a mesh.
+struct MetricSummary {
+  HexMetric metric;
+  std::size_t count = 0;        ///< elements
+  std::size_t degenerate = 0;   ///< Verdict's 1e30 marker: never counted as good
+  double min = 0, max = 0, mean = 0;  ///< over the non-degenerate elements
+  std::size_t inverted = 0;     ///< scaled Jacobian < 0 (scaled_jacobian only)
+  std::size_t questionable = 0; ///< 0 <= scaled Jacobian < 0.2 (scaled_jacobian only)
+  Histogram histogram;
+  std::vector<ElementValue> worst;  ///< worst first; degenerate elements lead
+};
+
+/// Summarises `values` (one per hex) of metric `m`, keeping the `worst` worst elements.
+/// The scaled Jacobian uses the paper's fixed bins (width 0.1 over [-1, 1]); other metrics
+/// 20 equal bins over [min, max]. Sequential sums keep the mean identical for any thread count.
+MetricSummary summarize(HexMetric m, const std::vector<double>& values, std::size_t worst = 10);
+
+/// JSON object of a summary (histogram and worst elements included).
+nlohmann::json to_json(const MetricSummary& s);
+
+/// Options for the histogram figure.
+struct HistogramPlotOptions {
+  std::string title;         ///< e.g. the mesh name
+  bool log_scale = false;    ///< logarithmic count axis
+};
+
+/// Writes the histogram as an SVG figure (bars coloured by class for the scaled Jacobian:
+/// red inverted, orange questionable, green acceptable). Written atomically.
+void write_histogram_svg(const std::filesystem::path& file, const MetricSummary& s,
+                         const HistogramPlotOptions& options = {});
+/// The SVG text itself.
+std::string histogram_svg(const MetricSummary& s, const HistogramPlotOptions& options = {});
+
+}  // namespace isohex

@@ -1,0 +1,45 @@
+#include "test_support.hpp"
+
+#include "isohex/mesh/generate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <sys/wait.h>
+
+namespace isohex::test {
+
+namespace fs = std::filesystem;
+
+bool have_shared_data() { return fs::is_directory(ISOHEX_SHARED_DATA); }
+
+fs::path shared_data(const std::string& rel) {
+  return fs::path(ISOHEX_SHARED_DATA) / rel;
+}
+
+fs::path scratch_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  fs::path dir = fs::path(ISOHEX_TEST_TMP) / (std::string(info->test_suite_name()) + "." + info->name());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+HexMesh grid_mesh(int nx, int ny, int nz, double h) {
+  return box_mesh(nx, ny, nz, Vec3::Zero(), Vec3(nx * h, ny * h, nz * h));
+}
+
+int run_cli(const std::string& args, std::string* output) {
+  const std::string cmd = std::string(ISOHEX_CLI) + " " + args + " 2>&1";
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buf{};
+  std::string out;
+  while (size_t n = std::fread(buf.data(), 1, buf.size(), pipe)) out.append(buf.data(), n);
+  const int status = ::pclose(pipe);
+  if (output) *output = out;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace isohex::test

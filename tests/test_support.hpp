@@ -1,0 +1,29 @@
+#pragma once
+// Helpers shared by the tests: data paths, a scratch folder, generated meshes, running the CLI.
+
+#include "isohex/mesh/hex_mesh.hpp"
+
+#include <filesystem>
+#include <string>
+
+namespace isohex::test {
+
+/// `../shared/data/<rel>` (use ISOHEX_REQUIRE_SHARED_DATA() first in the test body).
+std::filesystem::path shared_data(const std::string& rel);
+/// True when the shared data folder exists.
+bool have_shared_data();
+/// A fresh, empty scratch folder named after the running test.
+std::filesystem::path scratch_dir();
+/// An nx*ny*nz grid of unit-spaced hexes (spacing h), vertices numbered x fastest.
+HexMesh grid_mesh(int nx, int ny, int nz, double h = 1.0);
+/// Runs the isohex CLI with `args` (a shell-quoted string); returns the exit code and
+/// captures stdout+stderr into `output`.
+int run_cli(const std::string& args, std::string* output = nullptr);
+
+}  // namespace isohex::test
+
+/// Skips the calling test when ../shared/data is absent.
+#define ISOHEX_REQUIRE_SHARED_DATA() \
+  do {                                                                        \
+    if (!::isohex::test::have_shared_data()) GTEST_SKIP() << "no shared data"; \
+  } while (0)
