@@ -80,7 +80,8 @@ TEST(Abaqus, ReadsIdsContinuationsAndSetsOfOtherWriters) {
   write_text(dir / "two.inp", kTwoHexes);
   expect_same_mesh(two_hexes(), io::read_mesh(dir / "two.inp"));
   // Set names that are not all EB<n> are numbered by first appearance; no set is block 0.
-  write_text(dir / "named.inp", replaced(replaced(kTwoHexes, "elset=EB2", "elset=Part-1"), " ELSET=eb5", " ELSET=\"part 2\""));
+  write_text(dir / "named.inp",
+             replaced(replaced(kTwoHexes, "elset=EB2", "elset=Part-1"), " ELSET=eb5", " ELSET=\"part 2\""));
   expect_same_mesh(two_hexes({2, 1}), io::read_mesh(dir / "named.inp"));
   write_text(dir / "noset.inp", replaced(replaced(kTwoHexes, "elset=EB2", "elset=Part-1"), ",\n ELSET=eb5", ""));
   expect_same_mesh(two_hexes({0, 1}), io::read_mesh(dir / "noset.inp"));
@@ -97,7 +98,8 @@ TEST(Abaqus, ReadsIdsContinuationsAndSetsOfOtherWriters) {
 
 TEST(Abaqus, FixedNodeSetMarksFixedVertices) {
   const fs::path dir = scratch_dir();
-  write_text(dir / "list.inp", std::string(kTwoHexes) + "*Nset, nset=Fixed\n 986, 923,\n1000\n*NSET, NSET=OTHER\n993\n");
+  write_text(dir / "list.inp",
+             std::string(kTwoHexes) + "*Nset, nset=Fixed\n 986, 923,\n1000\n*NSET, NSET=OTHER\n993\n");
   HexMesh expected = two_hexes();
   expected.fixed = {1, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 1};
   expect_same_mesh(expected, io::read_mesh(dir / "list.inp"));
@@ -158,7 +160,8 @@ TEST(Abaqus, NonHexElementsFailOrAreSkipped) {
                            "*ELEMENT, TYPE=C3D4, ELSET=tets\n31, 1000, 993, 979, 958\n32, 993, 986, 972, 951\n"
                            "*ELEMENT, TYPE=C3D20R\n41, 1000, 993, 972, 979, 958, 951, 930, 937, 1000, 993,\n"
                            "972, 979, 958, 951, 930, 937, 1000, 993, 972, 979\n";
-  expect_text_error(dir, "tets.inp", text, {": line 29: ", "element 31 has type C3D4, not a hexahedron", "skip_non_hex"});
+  expect_text_error(dir, "tets.inp", text,
+                    {": line 29: ", "element 31 has type C3D4, not a hexahedron", "skip_non_hex"});
   ReadOptions skip;
   skip.skip_non_hex = true;
   ReadReport report;
@@ -186,15 +189,26 @@ TEST(Abaqus, MalformedFilesNameTheLineAndTheFault) {
   expect_text_error(dir, "inf.inp", replaced(good, "979, 0, 1, 0", "979, -Inf, 1, 0"), {": line 8: ", "found '-Inf'"});
   expect_text_error(dir, "two_coords.inp", replaced(good, "979, 0, 1, 0", "979, 0, 1"),
                     {": line 8: ", "node 979 has 2 coordinates, 3 are needed"});
-  expect_text_error(dir, "node_twice.inp", replaced(good, "979, 0, 1, 0", "993, 0, 1, 0"), {": line 8: ", "node 993 is defined twice"});
-  expect_text_error(dir, "node_zero.inp", replaced(good, "979, 0, 1, 0", "0, 0, 1, 0"), {": line 8: ", "node id 0 is not positive"});
-  expect_text_error(dir, "element_twice.inp", replaced(good, "\n10, 1000", "\n20, 1000"), {": line 22: ", "element 20 is defined twice"});
+  expect_text_error(dir, "node_twice.inp", replaced(good, "979, 0, 1, 0", "993, 0, 1, 0"),
+                    {": line 8: ", "node 993 is defined twice"});
+  expect_text_error(dir, "node_zero.inp", replaced(good, "979, 0, 1, 0", "0, 0, 1, 0"),
+                    {": line 8: ", "node id 0 is not positive"});
+  expect_text_error(dir, "element_twice.inp", replaced(good, "\n10, 1000", "\n20, 1000"),
+                    {": line 22: ", "element 20 is defined twice"});
   expect_text_error(dir, "element_id.inp", replaced(good, "\n10, 1000", "\nten, 1000"),
                     {": line 22: ", "expected an element id (an integer), found 'ten'"});
   expect_text_error(dir, "notype.inp", replaced(good, "*Element, type=C3D8R, elset=EB2", "*Element, elset=EB2"),
                     {": line 17: ", "*ELEMENT without TYPE="});
-  expect_text_error(dir, "include.inp", replaced(good, "*Heading", "*INCLUDE, INPUT=nodes.inp"), {": line 2: ", "*INCLUDE is not supported"});
-  expect_text_error(dir, "fixed.inp", good + "*NSET, NSET=FIXED\n1000, 5\n", {": line 29: ", "NSET FIXED names node 5"});
+  expect_text_error(dir, "include.inp", replaced(good, "*Heading", "*INCLUDE, INPUT=nodes.inp"),
+                    {": line 2: ", "*INCLUDE is not supported"});
+  expect_text_error(dir, "fixed.inp", good + "*NSET, NSET=FIXED\n1000, 5\n",
+                    {": line 29: ", "NSET FIXED names node 5"});
+  expect_text_error(dir, "generate.inp",
+                    good + "*NSET, NSET=FIXED, GENERATE\n-9000000000000000000, 9000000000000000000\n",
+                    {": line 29: ", "is not a range of defined nodes"});
+  expect_text_error(dir, "generate2.inp",
+                    good + "*NSET, NSET=FIXED, GENERATE\n1, 9223372036854775807, 9223372036854775806\n",
+                    {": line 29: ", "NSET FIXED names node 1,"});
 }
 
 TEST(Abaqus, TruncationNeverCrashes) {

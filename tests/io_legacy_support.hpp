@@ -8,7 +8,6 @@
 #include "test_support.hpp"
 
 #include <fmt/format.h>
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -49,10 +48,12 @@ inline HexMesh awkward_mesh(bool with_blocks, bool with_fixed) {
   // Every other coordinate is replaced, so plain grid values stay in between.
   for (std::size_t v = 0; v < m.points.size(); ++v)
     for (int c = 0; c < 3; ++c)
-      if ((v + static_cast<std::size_t>(c)) % 2 == 0) m.points[v][c] = awkward[(3 * v + static_cast<std::size_t>(c)) % std::size(awkward)];
+      if ((v + static_cast<std::size_t>(c)) % 2 == 0)
+        m.points[v][c] = awkward[(3 * v + static_cast<std::size_t>(c)) % std::size(awkward)];
   if (with_blocks) {
     m.blocks.resize(m.hexes.size());
-    for (std::size_t h = 0; h < m.blocks.size(); ++h) m.blocks[h] = static_cast<Index>((h * 5) % 3 == 0 ? -4 : h % 4 + 1);
+    for (std::size_t h = 0; h < m.blocks.size(); ++h)
+      m.blocks[h] = static_cast<Index>((h * 5) % 3 == 0 ? -4 : h % 4 + 1);
     m.blocks.back() = std::numeric_limits<Index>::max();
   }
   if (with_fixed) {
@@ -90,7 +91,8 @@ inline std::string expect_read_error(const fs::path& file, const std::vector<std
   } catch (const Error& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find(file.string()), std::string::npos) << message;
-    for (const std::string& f : fragments) EXPECT_NE(message.find(f), std::string::npos) << "'" << f << "' not in: " << message;
+    for (const std::string& f : fragments)
+      EXPECT_NE(message.find(f), std::string::npos) << "'" << f << "' not in: " << message;
     return message;
   } catch (const std::exception& e) {
     ADD_FAILURE() << "not an isohex::Error: " << e.what();

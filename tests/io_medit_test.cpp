@@ -54,8 +54,12 @@ TEST(Medit, EcrFilesLoadWithTheirCounts) {
     const char* name;
     Index vertices, hexes;
   };
-  const Counts files[] = {{"block", 3180, 2520},    {"bust", 6314, 5258},    {"hanger_stresstest", 6633, 4539},
-                          {"impeller_stresstest", 15248, 11174}, {"dragon", 18147, 14009}, {"armadillo", 34726, 29935}};
+  const Counts files[] = {{"block", 3180, 2520},
+                          {"bust", 6314, 5258},
+                          {"hanger_stresstest", 6633, 4539},
+                          {"impeller_stresstest", 15248, 11174},
+                          {"dragon", 18147, 14009},
+                          {"armadillo", 34726, 29935}};
   for (const Counts& c : files)
     for (const char* suffix : {"_in", "_out"}) {
       const std::string name = std::string("hexmeshes/ecr2015_") + c.name + suffix + ".mesh";
@@ -71,7 +75,7 @@ TEST(Medit, EcrFilesLoadWithTheirCounts) {
     }
   const HexMesh block = io::read_mesh(shared_data("hexmeshes/ecr2015_block_in.mesh"));
   EXPECT_EQ(block.points[0], Vec3(0.309011, 0.327493, 0.226576));  // line 5
-  EXPECT_EQ(block.hexes[1], (Hex{3, 2, 8, 9, 7, 6, 10, 11}));       // "4 3 9 10 8 7 11 12 1"
+  EXPECT_EQ(block.hexes[1], (Hex{3, 2, 8, 9, 7, 6, 10, 11}));      // "4 3 9 10 8 7 11 12 1"
 }
 
 TEST(Medit, RoundTripsAwkwardCoordinatesExactly) {
@@ -143,7 +147,8 @@ TEST(Medit, NonHexCellsFailOrAreSkipped) {
   const HexMesh m = io::read_mesh(dir / "tets.mesh", skip, &report);
   EXPECT_EQ(report.skipped_cells, 2u);
   expect_same_mesh(grid_mesh(2, 1, 1), m);
-  expect_text_error(dir, "pyramids.mesh", replaced(kTwoHexes, "End", "Pyramids 3\n1 2 5 4 7 0\n1 2 5 4 7 0\n1 2 5 4 7 0\nEnd"),
+  expect_text_error(dir, "pyramids.mesh",
+                    replaced(kTwoHexes, "End", "Pyramids 3\n1 2 5 4 7 0\n1 2 5 4 7 0\n1 2 5 4 7 0\nEnd"),
                     {": line 25: ", "3 Pyramids are not hexahedra"});
 }
 
@@ -172,10 +177,12 @@ TEST(Medit, MalformedFilesNameTheLineAndTheFault) {
   expect_text_error(dir, "dim.mesh", replaced(good, "Dimension 3", "Dimension 2"), {": line 2: ", "only 3-D meshes"});
   expect_text_error(dir, "version.mesh", replaced(good, "MeshVersionFormatted 1", "MeshVersionFormatted 7"),
                     {": line 1: ", "MeshVersionFormatted 7"});
-  expect_text_error(dir, "order.mesh", replaced(replaced(good, "Hexahedra\n2\n1 2 5 4 7 8 11 10 0\n2 3 6 5 8 9 12 11 0\n", ""),
-                                                "Vertices", "Hexahedra 0\nVertices"),
+  expect_text_error(dir, "order.mesh",
+                    replaced(replaced(good, "Hexahedra\n2\n1 2 5 4 7 8 11 10 0\n2 3 6 5 8 9 12 11 0\n", ""), "Vertices",
+                             "Hexahedra 0\nVertices"),
                     {": line 3: ", "Hexahedra before Vertices"});
-  expect_text_error(dir, "nodim.mesh", replaced(good, "Dimension 3\n", ""), {": line 2: ", "Vertices before Dimension"});
+  expect_text_error(dir, "nodim.mesh", replaced(good, "Dimension 3\n", ""),
+                    {": line 2: ", "Vertices before Dimension"});
   expect_text_error(dir, "noend.mesh", replaced(good, "End\n", ""), {": line 25: ", "no End keyword"});
   expect_text_error(dir, "empty.mesh", "", {": line 1: ", "no End keyword"});
 }
@@ -200,7 +207,8 @@ TEST(Medit, EveryTruncationOfAGeneratedFileFails) {
   io::write_mesh(dir / "full.mesh", m);
   const std::string full = io::read_file(dir / "full.mesh");
   // End is required, so only dropping the final newline leaves a valid file.
-  sweep_prefixes(dir, "cut.mesh", full, all_lengths(full.size()), m, [&](std::size_t n) { return n + 1 >= full.size(); });
+  sweep_prefixes(dir, "cut.mesh", full, all_lengths(full.size()), m,
+                 [&](std::size_t n) { return n + 1 >= full.size(); });
 }
 
 TEST(Medit, TruncatedSharedFileFailsCleanly) {

@@ -3,7 +3,6 @@
 // truncation at every offset.
 
 #include "io_legacy_support.hpp"
-
 #include "isohex/io/big_endian.hpp"
 
 #include <chrono>
@@ -126,7 +125,11 @@ std::string every_section_file(bool binary) {
   b.line("FIELD FieldData 2").line("TIME 1 1 double").values(std::vector<double>{0.5});
   b.line("names 1 2 string").strings({"first name", "second%20name"});
   b.line("POINTS 12 double").values(coordinates(m));
-  b.line("METADATA").line("INFORMATION 1").line("NAME L2_NORM_RANGE LOCATION vtkDataArray").line("DATA 2 0 1.7").line("");
+  b.line("METADATA")
+      .line("INFORMATION 1")
+      .line("NAME L2_NORM_RANGE LOCATION vtkDataArray")
+      .line("DATA 2 0 1.7")
+      .line("");
   b.line("CELLS 3 16").line("OFFSETS vtktypeint32").values(std::vector<std::int32_t>{0, 8, 16});
   b.line("METADATA").line("COMPONENT_NAMES").line("x").line("");
   std::vector<std::int64_t> conn;
@@ -167,7 +170,7 @@ TEST(VtkLegacy, SharedFilesLoadWithTheirCounts) {
   EXPECT_EQ(rockarm.num_vertices(), 2651);
   EXPECT_EQ(rockarm.num_hexes(), 1858);
   EXPECT_EQ(rockarm.points[0], Vec3(0.0811033, -0.104003, -0.233597));  // line 6 of the file
-  EXPECT_EQ(rockarm.hexes[1], (Hex{9, 5, 4, 8, 11, 7, 6, 10}));          // line 2659
+  EXPECT_EQ(rockarm.hexes[1], (Hex{9, 5, 4, 8, 11, 7, 6, 10}));         // line 2659
   EXPECT_FALSE(rockarm.has_blocks());
   EXPECT_FALSE(rockarm.has_fixed());
 
@@ -234,7 +237,8 @@ TEST(VtkLegacy, RoundTripsSharedFiles) {
   const fs::path dir = scratch_dir();
   ReadOptions skip;
   skip.skip_non_hex = true;
-  for (const char* name : {"hexmeshes/rockarm.vtk", "hexmeshes/notch_stress_fixed.vtk", "hexmeshes/mesquite/pave1.e.vtk"}) {
+  for (const char* name :
+       {"hexmeshes/rockarm.vtk", "hexmeshes/notch_stress_fixed.vtk", "hexmeshes/mesquite/pave1.e.vtk"}) {
     const HexMesh m = io::read_mesh(shared_data(name), skip);
     for (const bool binary : {true, false}) {
       SCOPED_TRACE(fmt::format("{} binary {}", name, binary));
@@ -261,6 +265,38 @@ TEST(VtkLegacy, SkipsEverySectionItDoesNotUse) {
   }
 }
 
+TEST(VtkLegacy, ReadsPointsOfAnyNumericType) {
+  const fs::path dir = scratch_dir();
+  const HexMesh m = two_hexes();
+  std::vector<std::int32_t> cells;
+  for (const Hex& h : m.hexes) {
+    cells.push_back(8);
+    cells.insert(cells.end(), h.begin(), h.end());
+  }
+  const std::vector<double> c = coordinates(m);
+  for (const bool binary : {false, true}) {
+    SCOPED_TRACE(binary ? "binary" : "ASCII");
+    const auto check = [&](const std::string& type, const auto& values) {
+      VtkBuilder b(binary, "4.2");
+      b.line("POINTS 12 " + type).values(values).line("CELLS 2 18").values(cells);
+      b.line("CELL_TYPES 2").values(std::vector<std::int32_t>{12, 12});
+      write_text(dir / "points.vtk", b.str());
+      SCOPED_TRACE(type);
+      expect_same_mesh(m, io::read_mesh(dir / "points.vtk"));
+    };
+    check("unsigned_char", std::vector<std::uint8_t>(c.begin(), c.end()));
+    check("char", std::vector<std::int8_t>(c.begin(), c.end()));
+    check("short", std::vector<std::int16_t>(c.begin(), c.end()));
+    check("unsigned_short", std::vector<std::uint16_t>(c.begin(), c.end()));
+    check("int", std::vector<std::int32_t>(c.begin(), c.end()));
+    check("unsigned_int", std::vector<std::uint32_t>(c.begin(), c.end()));
+    check("vtktypeint64", std::vector<std::int64_t>(c.begin(), c.end()));
+    check("unsigned_long", std::vector<std::uint64_t>(c.begin(), c.end()));
+    check("float", std::vector<float>(c.begin(), c.end()));
+    check("double", c);
+  }
+}
+
 TEST(VtkLegacy, AcceptsWindowsLineEndingsAndLowerCaseKeywords) {
   const fs::path dir = scratch_dir();
   std::string text;
@@ -274,21 +310,25 @@ TEST(VtkLegacy, AcceptsWindowsLineEndingsAndLowerCaseKeywords) {
 TEST(VtkLegacy, ReadsBlockIdsUnderTheirUsualNames) {
   const fs::path dir = scratch_dir();
   for (const char* name : {"block", "BlockId", "CellEntityIds", "gmsh:physical", "MaterialIds"}) {
-    const std::string text = std::string(kTwoHexes) + "CELL_DATA 2\nSCALARS " + name + " int 1\nLOOKUP_TABLE default\n3 4\n";
+    const std::string text =
+        std::string(kTwoHexes) + "CELL_DATA 2\nSCALARS " + name + " int 1\nLOOKUP_TABLE default\n3 4\n";
     write_text(dir / "blocks.vtk", text);
     EXPECT_EQ(io::read_mesh(dir / "blocks.vtk").blocks, (std::vector<Index>{3, 4})) << name;
   }
   // Other cell arrays are not blocks; a non-integer block id is an error.
-  write_text(dir / "other.vtk", std::string(kTwoHexes) + "CELL_DATA 2\nSCALARS quality float\nLOOKUP_TABLE default\n3 4\n");
+  write_text(dir / "other.vtk",
+             std::string(kTwoHexes) + "CELL_DATA 2\nSCALARS quality float\nLOOKUP_TABLE default\n3 4\n");
   EXPECT_FALSE(io::read_mesh(dir / "other.vtk").has_blocks());
-  expect_text_error(dir, "half.vtk", std::string(kTwoHexes) + "CELL_DATA 2\nSCALARS block float\nLOOKUP_TABLE default\n3 4.5\n",
+  expect_text_error(dir, "half.vtk",
+                    std::string(kTwoHexes) + "CELL_DATA 2\nSCALARS block float\nLOOKUP_TABLE default\n3 4.5\n",
                     {": line 27: ", "cell 1 has block 4.5, not a 32-bit integer"});
 }
 
 TEST(VtkLegacy, ReadsVoxelsInHexOrder) {
   const fs::path dir = scratch_dir();
   // The first cell as a voxel: corners in lexicographic order (x fastest).
-  const std::string text = replaced(replaced(kTwoHexes, "8 0 1 4 3 6 7 10 9", "8 0 1 3 4 6 7 9 10"), "12\n12\n", "11\n12\n");
+  const std::string text =
+      replaced(replaced(kTwoHexes, "8 0 1 4 3 6 7 10 9", "8 0 1 3 4 6 7 9 10"), "12\n12\n", "11\n12\n");
   write_text(dir / "voxel.vtk", text);
   expect_same_mesh(two_hexes(), io::read_mesh(dir / "voxel.vtk"));
 }
@@ -329,16 +369,21 @@ TEST(VtkLegacy, MalformedAsciiFilesNameTheLineAndTheFault) {
   expect_text_error(dir, "keyword.vtk", good + "FOO 3\n", {": line 24: ", "unknown keyword 'FOO'"});
   expect_text_error(dir, "size.vtk", replaced(good, "CELLS 2 18", "CELLS 2 19"),
                     {": line 20: ", "CELLS size is 19 but its 2 cells hold 18 values"});
-  expect_text_error(dir, "npts.vtk", replaced(good, "CELLS 2 18", "CELLS 2 17"), {": line 20: ", "cell 1 declares 8 points"});
+  expect_text_error(dir, "npts.vtk", replaced(good, "CELLS 2 18", "CELLS 2 17"),
+                    {": line 20: ", "cell 1 declares 8 points"});
   expect_text_error(dir, "types.vtk", replaced(good, "CELL_TYPES 2", "CELL_TYPES 3"),
                     {": line 21: ", "CELL_TYPES has 3 entries for 2 cells"});
-  expect_text_error(dir, "pointdata.vtk", good + "POINT_DATA 11\n", {": line 24: ", "POINT_DATA has 11 values for 12 points"});
-  expect_text_error(dir, "seven.vtk", replaced(replaced(good, "CELLS 2 18", "CELLS 2 17"), "8 0 1 4 3 6 7 10 9", "7 0 1 4 3 6 7 10"),
+  expect_text_error(dir, "pointdata.vtk", good + "POINT_DATA 11\n",
+                    {": line 24: ", "POINT_DATA has 11 values for 12 points"});
+  expect_text_error(dir, "seven.vtk",
+                    replaced(replaced(good, "CELLS 2 18", "CELLS 2 17"), "8 0 1 4 3 6 7 10 9", "7 0 1 4 3 6 7 10"),
                     {": line 22: ", "cell 0 is a hexahedron (VTK type 12) with 7 points instead of 8"});
-  expect_text_error(dir, "type.vtk", replaced(good, "12\n12\n", "12\n99\n"), {": line 23: ", "cell 1 has unknown VTK cell type 99"});
+  expect_text_error(dir, "type.vtk", replaced(good, "12\n12\n", "12\n99\n"),
+                    {": line 23: ", "cell 1 has unknown VTK cell type 99"});
   ReadOptions skip;
   skip.skip_non_hex = true;
-  expect_text_error(dir, "type_skip.vtk", replaced(good, "12\n12\n", "12\n-4\n"), {": line 23: ", "unknown VTK cell type -4"}, skip);
+  expect_text_error(dir, "type_skip.vtk", replaced(good, "12\n12\n", "12\n-4\n"),
+                    {": line 23: ", "unknown VTK cell type -4"}, skip);
   expect_text_error(dir, "datatype.vtk", replaced(good, "POINTS 12 float", "POINTS 12 real"),
                     {": line 5: ", "unknown data type 'real'"});
   expect_text_error(dir, "nocells.vtk", good.substr(0, good.find("CELLS")), {"no CELLS section"});
@@ -349,13 +394,16 @@ TEST(VtkLegacy, MalformedAsciiFilesNameTheLineAndTheFault) {
 TEST(VtkLegacy, MalformedOffsetsAreRefused) {
   const fs::path dir = scratch_dir();
   const std::string good = every_section_file(false);
-  expect_text_error(dir, "first.vtk", replaced(good, "0 8 16\n", "1 8 16\n"), {"the first cell offset must be 0, found 1"});
-  expect_text_error(dir, "down.vtk", replaced(good, "0 8 16\n", "0 9 8\n"), {"cell offset 2 is 8, less than the previous offset 9"});
+  expect_text_error(dir, "first.vtk", replaced(good, "0 8 16\n", "1 8 16\n"),
+                    {"the first cell offset must be 0, found 1"});
+  expect_text_error(dir, "down.vtk", replaced(good, "0 8 16\n", "0 9 8\n"),
+                    {"cell offset 2 is 8, less than the previous offset 9"});
   expect_text_error(dir, "last.vtk", replaced(good, "0 8 16\n", "0 8 15\n"),
                     {"the last cell offset is 15 but CELLS declares 16 connectivity values"});
   expect_text_error(dir, "float.vtk", replaced(good, "OFFSETS vtktypeint32", "OFFSETS float"),
                     {"cell offset must have an integer type, not 'float'"});
-  expect_text_error(dir, "noconn.vtk", replaced(good, "CONNECTIVITY", "CONNECTIONS"), {"expected CONNECTIVITY, found 'CONNECTIONS'"});
+  expect_text_error(dir, "noconn.vtk", replaced(good, "CONNECTIVITY", "CONNECTIONS"),
+                    {"expected CONNECTIVITY, found 'CONNECTIONS'"});
 }
 
 TEST(VtkLegacy, MalformedBinaryFilesNameTheByteOffset) {
@@ -366,18 +414,21 @@ TEST(VtkLegacy, MalformedBinaryFilesNameTheByteOffset) {
   b.line("POINTS 12 double");
   const std::size_t data = b.size();
   b.values(c);
-  expect_text_error(dir, "nan.vtk", b.str(), {fmt::format(": byte {}: ", data + 7 * 8), "point 2 has a non-finite coordinate"});
+  expect_text_error(dir, "nan.vtk", b.str(),
+                    {fmt::format(": byte {}: ", data + 7 * 8), "point 2 has a non-finite coordinate"});
 
   VtkBuilder ids(true, "4.2");
   ids.line("POINTS 12 double").values(coordinates(two_hexes())).line("CELLS 1 9");
   const std::size_t cells = ids.size();
   ids.values(std::vector<std::int32_t>{8, 0, 1, 2, 3, 4, 5, 6, -12});
-  expect_text_error(dir, "id.vtk", ids.str(), {fmt::format(": byte {}: ", cells + 8 * 4), "vertex id -12 out of range"});
+  expect_text_error(dir, "id.vtk", ids.str(),
+                    {fmt::format(": byte {}: ", cells + 8 * 4), "vertex id -12 out of range"});
 
   VtkBuilder junk(true, "4.2");
   junk.line("POINTS 12 double").values(coordinates(two_hexes()));
   const std::size_t after = junk.size();
-  expect_text_error(dir, "junk.vtk", junk.str() + "\x01\x02garbage\n", {fmt::format(": byte {}: ", after), "unknown keyword '\\x01\\x02garbage'"});
+  expect_text_error(dir, "junk.vtk", junk.str() + "\x01\x02garbage\n",
+                    {fmt::format(": byte {}: ", after), "unknown keyword '\\x01\\x02garbage'"});
 }
 
 TEST(VtkLegacy, HugeDeclaredCountsAreRefusedQuickly) {
@@ -386,13 +437,18 @@ TEST(VtkLegacy, HugeDeclaredCountsAreRefusedQuickly) {
   const std::string head = "# vtk DataFile Version 4.2\nhuge\nASCII\nDATASET UNSTRUCTURED_GRID\n";
   const std::string bin = "# vtk DataFile Version 4.2\nhuge\nBINARY\nDATASET UNSTRUCTURED_GRID\n";
   expect_text_error(dir, "a.vtk", head + "POINTS 999999999999 double\n0 0 0\n", {": line 5: ", "exceeds the limit"});
-  expect_text_error(dir, "b.vtk", head + "POINTS 2000000000 double\n0 0 0\n", {": line 5: ", "declares 6000000000 values"});
-  expect_text_error(dir, "c.vtk", bin + "POINTS 2000000000 double\n\x3f\xf0", {": byte ", "declares 6000000000 values"});
+  expect_text_error(dir, "b.vtk", head + "POINTS 2000000000 double\n0 0 0\n",
+                    {": line 5: ", "declares 6000000000 values"});
+  expect_text_error(dir, "c.vtk", bin + "POINTS 2000000000 double\n\x3f\xf0",
+                    {": byte ", "declares 6000000000 values"});
   expect_text_error(dir, "d.vtk", head + "POINTS 1 double\n0 0 0\nCELLS 1 999999999999999\n8 0 0 0 0 0 0 0 0\n",
                     {": line 7: ", "CELLS declares 999999999999999 values"});
-  expect_text_error(dir, "e.vtk", head + "POINTS 1 double\n0 0 0\nCELLS 2 9223372036854775807\nOFFSETS vtktypeint64\n0 9223372036854775807\n"
-                        "CONNECTIVITY vtktypeint64\n0\n",
-                    {"CONNECTIVITY declares 9223372036854775807 values"});
+  expect_text_error(
+      dir, "e.vtk",
+      head +
+          "POINTS 1 double\n0 0 0\nCELLS 2 9223372036854775807\nOFFSETS vtktypeint64\n0 9223372036854775807\n"
+          "CONNECTIVITY vtktypeint64\n0\n",
+      {"CONNECTIVITY declares 9223372036854775807 values"});
   expect_text_error(dir, "f.vtk", head + "POINTS 1 double\n0 0 0\nFIELD f 1\nx 100000000 100000000 double\n1\n",
                     {"x declares 10000000000000000 values"});
   expect_text_error(dir, "g.vtk", head + "POINTS 1 double\n0 0 0\nCELLS 99999999999 99999999999\n",

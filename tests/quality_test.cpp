@@ -57,7 +57,7 @@ HexMesh random_hexes(int n, std::uint64_t seed) {
       Vec3 p = cube[static_cast<std::size_t>(i)];
       if (kind != 6) p += amp * Vec3(u(rng), u(rng), u(rng));
       if (kind == 3 && i == 6) p = Vec3(0.3, 0.3, 0.3);  // corner 6 pulled inside: inverted
-      if (kind == 4) p.z() *= 1e-7;                       // nearly flat
+      if (kind == 4) p.z() *= 1e-5;                       // nearly flat (far above the threshold)
       p = affine * p * scale + offset;
       hex[static_cast<std::size_t>(i)] = m.num_vertices();
       m.points.push_back(p);

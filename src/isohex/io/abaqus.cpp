@@ -229,9 +229,12 @@ class AbaqusReader {
 
   void read_data(std::string_view t) {
     switch (mode_) {
-      case Mode::skip: return;
-      case Mode::node: return read_node(t);
-      case Mode::fixed_set: return read_fixed(t);
+      case Mode::skip:
+        return;
+      case Mode::node:
+        return read_node(t);
+      case Mode::fixed_set:
+        return read_fixed(t);
       case Mode::hex:
       case Mode::non_hex:
         if (record_.empty()) record_line_ = line_;
@@ -250,8 +253,7 @@ class AbaqusReader {
     split_fields(t, fields_);
     if (fields_.size() > 1 && fields_.back().empty()) fields_.pop_back();
     const std::int64_t id = integer(fields_[0], "a node id");
-    if (fields_.size() < 4)
-      fail(fmt::format("node {} has {} coordinates, 3 are needed", id, fields_.size() - 1));
+    if (fields_.size() < 4) fail(fmt::format("node {} has {} coordinates, 3 are needed", id, fields_.size() - 1));
     if (id < 1) fail(fmt::format("node id {} is not positive", id));
     if (points_.size() >= static_cast<std::size_t>(std::numeric_limits<Index>::max()))
       fail("too many nodes for 32-bit indices");
@@ -288,9 +290,11 @@ class AbaqusReader {
     const std::int64_t first = integer(fields_[0], "the first node id");
     const std::int64_t last = integer(fields_[1], "the last node id");
     const std::int64_t step = fields_.size() == 3 ? integer(fields_[2], "the step") : 1;
-    if (step < 1 || last < first || (last - first) / step > static_cast<std::int64_t>(points_.size()))
+    // first >= 1 keeps last - first from overflowing; the count bounds the loop.
+    if (first < 1 || step < 1 || last < first || (last - first) / step >= static_cast<std::int64_t>(points_.size()))
       fail(fmt::format("NSET FIXED, GENERATE range {}, {}, {} is not a range of defined nodes", first, last, step));
-    for (std::int64_t id = first; id <= last; id += step) {
+    for (std::int64_t k = 0; k <= (last - first) / step; ++k) {
+      const std::int64_t id = first + k * step;
       const Index v = node_index_.find(id);
       if (v < 0) fail(fmt::format("NSET FIXED names node {}, which is not defined (before this line)", id));
       fixed_list_.push_back(v);
@@ -303,8 +307,9 @@ class AbaqusReader {
     const std::int64_t id = integer(record_[0], "an element id", record_line_);
     if (mode_ == Mode::non_hex) {
       if (!options_.skip_non_hex)
-        fail(fmt::format("element {} has type {}, not a hexahedron (C3D8, C3D8R, ...); read with skip_non_hex to drop it",
-                         id, element_type_),
+        fail(fmt::format(
+                 "element {} has type {}, not a hexahedron (C3D8, C3D8R, ...); read with skip_non_hex to drop it", id,
+                 element_type_),
              record_line_);
       ++skipped_;
       record_.clear();
@@ -316,7 +321,8 @@ class AbaqusReader {
     if (hexes_.size() >= static_cast<std::size_t>(std::numeric_limits<Index>::max()))
       fail("too many elements for 32-bit indices", record_line_);
     Hex h;
-    for (int i = 0; i < 8; ++i) h[static_cast<std::size_t>(i)] = node_of_element(record_[static_cast<std::size_t>(i) + 1], id);
+    for (int i = 0; i < 8; ++i)
+      h[static_cast<std::size_t>(i)] = node_of_element(record_[static_cast<std::size_t>(i) + 1], id);
     if (!element_index_.insert(id, static_cast<Index>(hexes_.size())))
       fail(fmt::format("element {} is defined twice", id), record_line_);
     hexes_.push_back(h);
@@ -350,7 +356,8 @@ class AbaqusReader {
     std::vector<std::size_t> order(hexes_.size());
     std::iota(order.begin(), order.end(), std::size_t{0});
     if (!std::is_sorted(element_ids_.begin(), element_ids_.end()))
-      std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return element_ids_[a] < element_ids_[b]; });
+      std::sort(order.begin(), order.end(),
+                [&](std::size_t a, std::size_t b) { return element_ids_[a] < element_ids_[b]; });
     const std::vector<Index> ids = block_ids();
     mesh.hexes.reserve(hexes_.size());
     std::vector<Index> blocks;

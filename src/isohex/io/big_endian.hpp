@@ -10,11 +10,24 @@
 namespace isohex::io {
 
 namespace detail {
-template <std::size_t N> struct UnsignedOfSize;
-template <> struct UnsignedOfSize<1> { using type = std::uint8_t; };
-template <> struct UnsignedOfSize<2> { using type = std::uint16_t; };
-template <> struct UnsignedOfSize<4> { using type = std::uint32_t; };
-template <> struct UnsignedOfSize<8> { using type = std::uint64_t; };
+template <std::size_t N>
+struct UnsignedOfSize;
+template <>
+struct UnsignedOfSize<1> {
+  using type = std::uint8_t;
+};
+template <>
+struct UnsignedOfSize<2> {
+  using type = std::uint16_t;
+};
+template <>
+struct UnsignedOfSize<4> {
+  using type = std::uint32_t;
+};
+template <>
+struct UnsignedOfSize<8> {
+  using type = std::uint64_t;
+};
 }  // namespace detail
 
 /// The value of type T stored big-endian at `p` (no alignment needed).

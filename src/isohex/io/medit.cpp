@@ -176,16 +176,29 @@ class MeditReader {
         have_dimension_ = true;
         break;
       }
-      case Kind::vertices: read_vertices(); break;
-      case Kind::hexahedra: read_hexahedra(); break;
-      case Kind::required_vertices: read_required_vertices(); break;
-      case Kind::non_hex: read_non_hex(k); break;
-      case Kind::skip: skip_entries(k.name, count(k.name, k.values), k.values); break;
+      case Kind::vertices:
+        read_vertices();
+        break;
+      case Kind::hexahedra:
+        read_hexahedra();
+        break;
+      case Kind::required_vertices:
+        read_required_vertices();
+        break;
+      case Kind::non_hex:
+        read_non_hex(k);
+        break;
+      case Kind::skip:
+        skip_entries(k.name, count(k.name, k.values), k.values);
+        break;
       case Kind::single:
         for (int i = 0; i < k.values; ++i) real(fmt::format("the {} value", k.name));
         break;
-      case Kind::solution: skip_solution(k.name); break;
-      case Kind::end: return true;
+      case Kind::solution:
+        skip_solution(k.name);
+        break;
+      case Kind::end:
+        return true;
     }
     return false;
   }
@@ -214,7 +227,8 @@ class MeditReader {
     std::int64_t id = 0;
     if (t.empty() || !parse_int(t, id))  // messages are only formatted on failure: this is the hot loop
       sc_.fail(t.empty() ? fmt::format("unexpected end of file, expected a vertex id of {} {}", element, e + 1)
-                         : fmt::format("expected a vertex id of {} {} (an integer), found '{}'", element, e + 1, printable(t)));
+                         : fmt::format("expected a vertex id of {} {} (an integer), found '{}'", element, e + 1,
+                                       printable(t)));
     if (id < 1 || id > static_cast<std::int64_t>(points_.size()))
       sc_.fail(fmt::format("{} {} has vertex id {} out of range [1, {}]", element, e + 1, id, points_.size()));
     return static_cast<Index>(id - 1);

@@ -7,7 +7,7 @@
 /// | `.vtk`         | legacy VTK UNSTRUCTURED_GRID, ASCII or BINARY, 4.2 and 5.1    |
 /// | `.vtu`         | VTK XML UnstructuredGrid: ascii, base64 inline, appended raw, zlib |
 /// | `.mesh`        | MEDIT / GMF ASCII (Vertices, Hexahedra, references)           |
-/// | `.inp`         | Abaqus input (C3D8, C3D8R)                                    |
+/// | `.inp`         | Abaqus input (C3D8 and its variants C3D8R, C3D8I, C3D8H, ...)  |
 ///
 /// Every reader throws isohex::Error naming the file, the place (line or byte offset) and
 /// the fault; it never crashes or hangs on malformed input, and refuses declared counts

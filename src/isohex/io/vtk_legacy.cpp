@@ -6,14 +6,12 @@
 // then raw bytes), so binary arrays are located by consuming the rest of the header line.
 // Errors name a line in ASCII files and a byte offset in binary ones.
 
-#include "isohex/io/vtk_legacy_types.hpp"
-
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
-#include "isohex/io/big_endian.hpp"
 #include "isohex/io/format_support.hpp"
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/io/text_scanner.hpp"
+#include "isohex/io/vtk_legacy_types.hpp"
 
 #include <fmt/format.h>
 
@@ -33,53 +31,6 @@ constexpr std::uint64_t kMaxIndex = static_cast<std::uint64_t>(std::numeric_limi
 constexpr std::uint64_t kMaxCount = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
-
-/// Calls f(i, value) for the n big-endian values of type T at p.
-template <class T, class F>
-void each_be(const unsigned char* p, std::uint64_t n, F& f) {
-  for (std::uint64_t i = 0; i < n; ++i) f(i, load_be<T>(p + i * sizeof(T)));
-}
-
-/// Decodes n binary values of scalar type s (not bit or string) and passes them to f.
-template <class F>
-void decode_binary(vtk::Scalar s, const unsigned char* p, std::uint64_t n, F&& f) {
-  using vtk::Scalar;
-  switch (s) {
-    case Scalar::i8: each_be<std::int8_t>(p, n, f); break;
-    case Scalar::u8: each_be<std::uint8_t>(p, n, f); break;
-    case Scalar::i16: each_be<std::int16_t>(p, n, f); break;
-    case Scalar::u16: each_be<std::uint16_t>(p, n, f); break;
-    case Scalar::i32: each_be<std::int32_t>(p, n, f); break;
-    case Scalar::u32: each_be<std::uint32_t>(p, n, f); break;
-    case Scalar::i64: each_be<std::int64_t>(p, n, f); break;
-    case Scalar::u64: each_be<std::uint64_t>(p, n, f); break;
-    case Scalar::f32: each_be<float>(p, n, f); break;
-    case Scalar::f64: each_be<double>(p, n, f); break;
-    case Scalar::bit:
-    case Scalar::string: break;  // handled by the callers
-  }
-}
-
-int hex_digit(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  return -1;
-}
-
-/// Array names are %XX-encoded in legacy files ("Nodal%20Stress").
-std::string decode_name(std::string_view s) {
-  std::string out;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '%' && i + 2 < s.size() && hex_digit(s[i + 1]) >= 0 && hex_digit(s[i + 2]) >= 0) {
-      out += static_cast<char>(hex_digit(s[i + 1]) * 16 + hex_digit(s[i + 2]));
-      i += 2;
-    } else {
-      out += s[i];
-    }
-  }
-  return out;
-}
 
 bool is_block_array_name(std::string_view name) {
   for (std::string_view known : {"block", "BlockId", "CellEntityIds", "gmsh:physical", "MaterialIds"})
@@ -134,7 +85,8 @@ class LegacyReader {
     std::int64_t v = 0;
     if (!parse_int(t, v) || v < 0)
       fail_at(token_start_, fmt::format("expected {} (a non-negative integer), found '{}'", what, printable(t)));
-    if (static_cast<std::uint64_t>(v) > max) fail_at(token_start_, fmt::format("{} {} exceeds the limit of {}", what, v, max));
+    if (static_cast<std::uint64_t>(v) > max)
+      fail_at(token_start_, fmt::format("{} {} exceeds the limit of {}", what, v, max));
     return static_cast<std::uint64_t>(v);
   }
 
@@ -223,7 +175,7 @@ class LegacyReader {
       for (std::uint64_t i = 0; i < n; ++i) sink(i, static_cast<double>((p[i / 8] >> (7 - i % 8)) & 1));
     } else {
       const unsigned char* p = take(n * vtk::size_of(s), what);
-      decode_binary(s, p, n, [&](std::uint64_t i, auto v) { sink(i, static_cast<double>(v)); });
+      vtk::decode_binary(s, p, n, [&](std::uint64_t i, auto v) { sink(i, static_cast<double>(v)); });
     }
     skip_metadata();
   }
@@ -246,7 +198,7 @@ class LegacyReader {
       for (std::uint64_t i = 0; i < n; ++i) sink(i, std::int64_t{(p[i / 8] >> (7 - i % 8)) & 1});
     } else {
       const unsigned char* p = take(n * vtk::size_of(s), what);
-      decode_binary(s, p, n, [&](std::uint64_t i, auto v) {
+      vtk::decode_binary(s, p, n, [&](std::uint64_t i, auto v) {
         if constexpr (std::is_same_v<decltype(v), std::uint64_t>)
           if (v > kMaxCount) fail_value(i, fmt::format("{} {} is too large", what, v));
         sink(i, static_cast<std::int64_t>(v));
@@ -322,7 +274,8 @@ class LegacyReader {
     expect_keyword("DATASET");
     const std::string_view type = token("the dataset type");
     if (!iequals(type, "UNSTRUCTURED_GRID"))
-      fail_at(token_start_, fmt::format("dataset type '{}' is not supported (only UNSTRUCTURED_GRID)", printable(type)));
+      fail_at(token_start_,
+              fmt::format("dataset type '{}' is not supported (only UNSTRUCTURED_GRID)", printable(type)));
   }
 
   void read_keyword() {
@@ -381,7 +334,8 @@ class LegacyReader {
   /// Versions up to 4.2: `size` ints holding "npts id0 id1 ..." per cell.
   void read_cell_records(std::uint64_t ncells, std::uint64_t size) {
     if (ncells > kMaxIndex) fail_at(token_start_, fmt::format("{} cells exceed the limit of {}", ncells, kMaxIndex));
-    if (size < ncells) fail_at(token_start_, fmt::format("CELLS size {} is smaller than the cell count {}", size, ncells));
+    if (size < ncells)
+      fail_at(token_start_, fmt::format("CELLS size {} is smaller than the cell count {}", size, ncells));
     check_room(size, vtk::Scalar::i32, "CELLS");
     offsets_.assign(ncells + 1, 0);
     conn_.clear();
@@ -400,8 +354,8 @@ class LegacyReader {
       if (k >= size) fail_value(k, fmt::format("CELLS size {} is too small for {} cells", size, ncells));
       const std::int64_t npts = value(k++);
       if (npts < 0 || static_cast<std::uint64_t>(npts) > size - k)
-        fail_value(k - 1, fmt::format("cell {} declares {} points, but only {} values of CELLS size {} are left",
-                                      c, npts, size - k, size));
+        fail_value(k - 1, fmt::format("cell {} declares {} points, but only {} values of CELLS size {} are left", c,
+                                      npts, size - k, size));
       for (std::int64_t j = 0; j < npts; ++j, ++k) {
         const std::int64_t id = value(k);
         check_vertex_id(id, c, k);
@@ -473,8 +427,8 @@ class LegacyReader {
     constexpr std::size_t kNamed = 8;
     if (non_hex_count_ == 0) non_hex_place_ = value_place(cell);
     if (non_hex_count_ < kNamed)
-      non_hex_names_ += fmt::format("{}cell {} ({}, VTK type {})", non_hex_count_ ? ", " : "", cell,
-                                    vtk::cell_type_name(type), type);
+      non_hex_names_ +=
+          fmt::format("{}cell {} ({}, VTK type {})", non_hex_count_ ? ", " : "", cell, vtk::cell_type_name(type), type);
     else if (non_hex_count_ == kNamed)
       non_hex_names_ += ", ...";
     ++non_hex_count_;
@@ -482,13 +436,15 @@ class LegacyReader {
 
   void begin_attributes(Section section) {
     const std::size_t at = token_start_;
-    const std::uint64_t n = count(section == Section::point_data ? "the POINT_DATA count" : "the CELL_DATA count", kMaxCount);
+    const std::uint64_t n =
+        count(section == Section::point_data ? "the POINT_DATA count" : "the CELL_DATA count", kMaxCount);
     if (section == Section::point_data) {
       if (!have_points_) fail_at(at, "POINT_DATA before POINTS");
       if (n != points_.size()) fail_at(at, fmt::format("POINT_DATA has {} values for {} points", n, points_.size()));
     } else {
       if (!have_cells_) fail_at(at, "CELL_DATA before CELLS");
-      if (n != offsets_.size() - 1) fail_at(at, fmt::format("CELL_DATA has {} values for {} cells", n, offsets_.size() - 1));
+      if (n != offsets_.size() - 1)
+        fail_at(at, fmt::format("CELL_DATA has {} values for {} cells", n, offsets_.size() - 1));
     }
     section_ = section;
     tuples_ = n;
@@ -498,7 +454,7 @@ class LegacyReader {
   bool read_attribute(std::string_view kw) {
     const vtk::Scalar reals = binary_ ? vtk::Scalar::u8 : vtk::Scalar::f32;  // colours and tables
     if (iequals(kw, "SCALARS")) {
-      const std::string name = decode_name(token("the SCALARS name"));
+      const std::string name = vtk::decode_name(token("the SCALARS name"));
       const vtk::Scalar s = data_type("SCALARS");
       const std::string type = std::string(type_name_);
       std::uint64_t ncomp = 1;
@@ -543,7 +499,7 @@ class LegacyReader {
     for (std::uint64_t a = 0; a < narrays; ++a) {
       const std::string_view raw = token("a FIELD array name");
       if (raw == "NULL_ARRAY") continue;
-      const std::string name = decode_name(raw);
+      const std::string name = vtk::decode_name(raw);
       const std::uint64_t ncomp = count("the number of components", kMaxCount);
       const std::uint64_t ntuples = count("the number of tuples", kMaxCount);
       const vtk::Scalar s = data_type("the FIELD array");

@@ -17,8 +17,8 @@ namespace isohex::io {
 namespace {
 
 void write_header(std::ostream& out, bool binary) {
-  out << "# vtk DataFile Version 4.2\nisohex hex mesh\n" << (binary ? "BINARY" : "ASCII")
-      << "\nDATASET UNSTRUCTURED_GRID\n";
+  out << "# vtk DataFile Version 4.2\nisohex hex mesh\n"
+      << (binary ? "BINARY" : "ASCII") << "\nDATASET UNSTRUCTURED_GRID\n";
 }
 
 void write_binary(std::ostream& out, const HexMesh& mesh) {

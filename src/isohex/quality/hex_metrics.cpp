@@ -13,7 +13,6 @@ using detail::clamp_dbl_max;
 using detail::cross;
 using detail::dot;
 using detail::kDblMax;
-using detail::kVerdictDblMin;
 using detail::triple;
 using detail::VV;
 

@@ -3,9 +3,10 @@
 /// \brief Element quality metrics of hexahedra and quadrilaterals, as Verdict defines them.
 ///
 /// All element functions take the corners in VTK order and follow Verdict 1.4.5
-/// (sandialabs/verdict, `V_HexMetric.cpp`, `V_QuadMetric.cpp`; transcribed from the 1.4.4
-/// sources, which 1.4.5 keeps for these functions) operation for operation, so the values
-/// agree with Verdict bit for bit. Where Verdict reports a degenerate element it returns
+/// (sandialabs/verdict, `V_HexMetric.cpp`, `V_QuadMetric.cpp`) operation for operation, so
+/// the values agree with Verdict bit for bit. (Transcribed from the 1.4.4 sources, the newest
+/// we could read; they match the 1.4.5 step-by-step description in
+/// shared/notes/verdict-hex-scaled-jacobian.md and Verdict's own unit tests.) Where Verdict reports a degenerate element it returns
 /// kVerdictDblMax (1e30); use is_degenerate() so that such values are never taken for good
 /// quality.
 ///

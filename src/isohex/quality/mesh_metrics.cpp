@@ -31,7 +31,6 @@ namespace isohex {
 namespace {
 
 using detail::kDblMax;
-using detail::kVerdictDblMin;
 
 /// Hexes per batch: one AVX-512 register of doubles, two AVX2 ones, four SSE2 ones.
 constexpr int kLanes = 8;

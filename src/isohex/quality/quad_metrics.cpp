@@ -8,7 +8,6 @@ namespace isohex {
 
 using detail::cross;
 using detail::kDblMax;
-using detail::kVerdictDblMin;
 using detail::VV;
 
 namespace {

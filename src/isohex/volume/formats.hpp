@@ -3,11 +3,13 @@
 /// \brief The per-format readers and writers behind read_volume and write_volume.
 ///
 /// Why isohex parses NRRD and NIfTI itself instead of calling teem (libteem-dev) or
-/// niftilib (libnifti2-dev): both libraries allocate the data as soon as the header is
-/// parsed, before a caller could apply VolumeReadOptions::max_bytes; they report faults on
-/// stderr (niftilib) or in a global message buffer (teem's biff, not thread-safe) instead
-/// of naming the header field; and they would add two run-time dependencies for headers
-/// of a few dozen lines. The formats' own specifications are short and were followed here.
+/// niftilib (libnifti2-dev): both read the data into a buffer of their own type that would
+/// then be converted to floats (twice the memory of decoding chunk by chunk into the
+/// volume), neither applies a caller's memory limit before it allocates, and both report
+/// faults as free text in their own channels (teem's global, not thread-safe biff buffer;
+/// niftilib's stderr) rather than as an error naming the file and the header field. Both
+/// formats are a short header in front of raw or gzip data, which the MetaImage and VTK
+/// readers here decode anyway; the formats' specifications were followed.
 
 #include "isohex/error.hpp"
 #include "isohex/volume/byte_source.hpp"

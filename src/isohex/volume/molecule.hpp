@@ -2,8 +2,8 @@
 /// \file molecule.hpp
 /// \brief Molecules (PDB, PQR) and their blobby Gaussian density maps.
 ///
-/// A molecule becomes a Volume through the "blobby" density of Blinn (1982), the model
-/// behind the mAChE mesh of Shepherd et al. (2006) (Zhang, Xu & Bajaj's molecular meshes):
+/// A molecule becomes a Volume through the "blobby" density of Blinn (1982), the kind of
+/// map the mAChE mesh of Shepherd et al. (2006) was extracted from:
 ///
 ///     G(x) = sum over atoms i of  exp(-B · (|x - c_i|² / r_i² - 1))
 ///
@@ -14,7 +14,7 @@
 ///
 /// Readers:
 ///  - PDB: fixed columns. ATOM and HETATM records; x 31-38, y 39-46, z 47-54, element
-///    77-78. When the element columns are blank or not an element symbol (pre-1996 files
+///    77-78. When the element columns are blank or not an element symbol (old files
 ///    such as 1UBQ carry an ID and serial number in columns 73-80) the element comes from
 ///    the atom name (columns 13-16): a name whose column 13 is blank or a digit holds a
 ///    one-letter element in column 14 (" CA " is carbon, "1HB " hydrogen); a name starting
@@ -129,8 +129,10 @@ struct DensityReport {
 
 /// The per-atom threshold behind DensityOptions::epsilon: atoms are cut off where their
 /// term falls below epsilon · kAtomTailShare. The cut-off tails of all atoms near a point
-/// add up; in a protein (≈0.1 atoms/Å³ with hydrogens) they sum to about 25 atoms'
-/// worth at B = 0.5, so 1/100 keeps the total below epsilon with a margin of 4.
+/// add up: in a protein (about 0.1 atoms/Å³ with hydrogens) they come to tens of atoms'
+/// worth. Measured against the exact sum at B = 0.5, epsilon = 1e-3: mAChE (8,279 atoms
+/// with hydrogens) errs by at most 1.7e-4 with 1/250 (4.3e-4 with 1/100), so 1/250 keeps
+/// the total below epsilon with a margin of about 6.
 inline constexpr double kAtomTailShare = 1.0 / 250.0;
 
 /// The cut-off radius, in units of the atom radius, where exp(-B·(d²/r² - 1)) = threshold.

@@ -11,10 +11,10 @@
 #include <array>
 #include <cctype>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 namespace isohex {
 
@@ -82,14 +82,20 @@ std::string element_from_name(std::string_view name, bool hetatm) {
   return two.substr(0, 1);
 }
 
-// Applies the keep/skip options to an atom; returns whether to keep it.
+// Applies the keep/skip options to an atom, counting what it drops; true to keep it.
 bool keep_atom(const Atom& a, const MoleculeReadOptions& opt, MoleculeReadReport& rep) {
-  if (a.water) {
-    if (!opt.water) return ++rep.water_skipped, false;
-  } else if (a.hetatm && !opt.hetatm) {
-    return ++rep.hetatm_skipped, false;
+  if (a.water && !opt.water) {
+    ++rep.water_skipped;
+    return false;
   }
-  if (a.hydrogen && !opt.hydrogens) return ++rep.hydrogens_skipped, false;
+  if (!a.water && a.hetatm && !opt.hetatm) {
+    ++rep.hetatm_skipped;
+    return false;
+  }
+  if (a.hydrogen && !opt.hydrogens) {
+    ++rep.hydrogens_skipped;
+    return false;
+  }
   return true;
 }
 

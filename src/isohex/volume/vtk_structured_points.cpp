@@ -1,6 +1,7 @@
 // Legacy VTK STRUCTURED_POINTS volumes (.vtk), ASCII or BINARY (always big-endian):
 // DIMENSIONS, SPACING or its old name ASPECT_RATIO, ORIGIN, then POINT_DATA with one
-// SCALARS array. As in VTK's reader, binary values start right after the newline that
+// SCALARS array, or COLOR_SCALARS with one component (what VTK writes for unsigned char
+// images: bytes in binary files, byte/255 in ASCII ones). As in VTK's reader, binary values start right after the newline that
 // ends the LOOKUP_TABLE line (or the SCALARS line when there is no lookup table).
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
@@ -12,6 +13,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 
 namespace isohex::volume_detail {
@@ -26,6 +29,7 @@ struct LegacyHeader {
   Vec3 spacing = Vec3::Ones(), origin = Vec3::Zero();
   ScalarType type = ScalarType::f32;
   bool binary = false;
+  bool color = false;  // COLOR_SCALARS: u8, stored as byte/255 in ASCII files
   std::size_t data_offset = 0;
   std::size_t data_line = 1;
 };
@@ -86,8 +90,21 @@ LegacyHeader parse(const fs::path& file, std::string_view text) {
     sc.fail(fmt::format("POINT_DATA {} does not match DIMENSIONS {} x {} x {} = {}", n, h.dims[0], h.dims[1],
                         h.dims[2], h.dims[0] * h.dims[1] * h.dims[2]));
   const std::string_view attr = sc.expect("SCALARS");
+  if (iequals(attr, "COLOR_SCALARS")) {
+    sc.expect("the COLOR_SCALARS name");
+    const std::int64_t components = sc.next_int("the COLOR_SCALARS component count");
+    if (components != 1)
+      sc.fail(fmt::format("COLOR_SCALARS with {} components: isohex reads one (a grey-level image)", components));
+    sc.rest_of_line();
+    h.type = ScalarType::u8;
+    h.color = true;
+    h.data_offset = sc.offset();
+    h.data_line = sc.line();
+    return h;
+  }
   if (!iequals(attr, "SCALARS"))
-    sc.fail(fmt::format("isohex reads the SCALARS array of POINT_DATA; found '{}' first", io::printable(attr)));
+    sc.fail(fmt::format("isohex reads the SCALARS or COLOR_SCALARS array of POINT_DATA; found '{}' first",
+                        io::printable(attr)));
   sc.expect("the SCALARS name");
   const std::string_view type_name = sc.expect("the SCALARS data type");
   const auto vtk_type = io::vtk::scalar_named(type_name);
@@ -143,7 +160,14 @@ Volume read_vtk_structured_points(const fs::path& file, const VolumeReadOptions&
   } else {
     const std::string text = io::read_file(file);
     io::TextScanner sc(text, file, h.data_offset);
-    read_ascii_samples(sc, v, "SCALARS");
+    if (h.color) {  // values in [0, 1] standing for bytes, rounded back as VTK's reader does
+      v.source_type = ScalarType::f32;
+      read_ascii_samples(sc, v, "COLOR_SCALARS");
+      for (float& x : v.values) x = std::floor(std::clamp(x, 0.0f, 1.0f) * 255.0f + 0.5f);
+      v.source_type = ScalarType::u8;
+    } else {
+      read_ascii_samples(sc, v, "SCALARS");
+    }
   }
   return v;
 }
