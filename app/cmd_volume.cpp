@@ -136,12 +136,14 @@ void run_convert(const ConvertArgs& a) {
 }  // namespace
 
 void register_volume(CLI::App& app) {
-  CLI::App* volume = app.add_subcommand("volume", "Volumes: inspect and convert scans, make volumes of molecules and shapes");
+  CLI::App* volume =
+      app.add_subcommand("volume", "Volumes: inspect and convert scans, make volumes of molecules and shapes");
   volume->require_subcommand(1);
 
   auto info = std::make_shared<InfoArgs>();
   CLI::App* cmd = volume->add_subcommand("info", "Dimensions, spacing, value statistics and a suggested isovalue");
-  cmd->add_option("file", info->file, "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)")
+  cmd->add_option("file", info->file,
+                  "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)")
       ->required();
   cmd->add_option("--json", info->json, "Also write the report as JSON");
   cmd->add_option("--bins", info->bins, "Histogram bins to print (default 16)")->check(CLI::Range(1, 4096));

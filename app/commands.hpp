@@ -11,6 +11,7 @@ void register_quality(CLI::App& app);
 void register_check(CLI::App& app);
 void register_convert(CLI::App& app);
 void register_generate(CLI::App& app);
+void register_mesh(CLI::App& app);
 
 /// The exit code a command asks for (0 unless a command reports a failed check).
 int& exit_code();

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   isohex::cli::register_check(app);
   isohex::cli::register_convert(app);
   isohex::cli::register_generate(app);
+  isohex::cli::register_mesh(app);
   isohex::cli::register_volume(app);
   try {
     app.parse(argc, argv);

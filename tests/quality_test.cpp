@@ -79,13 +79,14 @@ double mean_ratio_reference(const Corners& p, double* slack) {
   double sum = 0;
   *slack = 0;
   for (int k = 0; k < 8; ++k) {
+    const auto& n = kCornerNeighbors[static_cast<std::size_t>(k)];
+    const Vec3& origin = p[static_cast<std::size_t>(k)];
     Eigen::Matrix3d a;
-    for (int j = 0; j < 3; ++j)
-      a.col(j) = p[static_cast<std::size_t>(kCornerNeighbors[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)])] -
-                 p[static_cast<std::size_t>(k)];
+    for (int j = 0; j < 3; ++j) a.col(j) = p[static_cast<std::size_t>(n[static_cast<std::size_t>(j)])] - origin;
     const double det = a.determinant();
     if (det > 0) sum += std::min(1.0, 3 * std::cbrt(det * det) / a.squaredNorm());
-    const double noise = 64 * std::numeric_limits<double>::epsilon() * a.col(0).norm() * a.col(1).norm() * a.col(2).norm();
+    const double noise =
+        64 * std::numeric_limits<double>::epsilon() * a.col(0).norm() * a.col(1).norm() * a.col(2).norm();
     if (std::fabs(det) <= noise) *slack += 3 * std::cbrt(noise * noise) / a.squaredNorm() / 8;
   }
   return sum / 8;

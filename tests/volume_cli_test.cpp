@@ -77,9 +77,7 @@ TEST(VolumeCli, ConvertToNrrdAndVti) {
 TEST(VolumeCli, BadInputExitsWithTwoAndNamesTheFault) {
   const fs::path dir = scratch_dir();
   std::string out;
-  {
-    std::ofstream(dir / "lie.nrrd") << "NRRD0004\ntype: uchar\ndimension: 3\nencoding: raw\nsizes: 4 4 -4\n\n";
-  }
+  { std::ofstream(dir / "lie.nrrd") << "NRRD0004\ntype: uchar\ndimension: 3\nencoding: raw\nsizes: 4 4 -4\n\n"; }
   EXPECT_EQ(run_cli("volume info " + q(dir / "lie.nrrd"), &out), 2);
   EXPECT_NE(out.find("lie.nrrd: field 'sizes'"), std::string::npos) << out;
   {

@@ -35,9 +35,7 @@ Volume read_raw(const std::string& name, const RawLayout& layout) {
   return read_volume(vol(name), opt);
 }
 
-void write_text(const fs::path& file, const std::string& text) {
-  std::ofstream(file, std::ios::binary) << text;
-}
+void write_text(const fs::path& file, const std::string& text) { std::ofstream(file, std::ios::binary) << text; }
 
 /// Values compared bit for bit (NaN-safe), and the geometry exactly.
 void expect_identical(const Volume& a, const Volume& b, const std::string& what) {
@@ -60,7 +58,13 @@ struct Expected {
 TEST(VolumeData, EveryVolumeMatchesSources) {
   ISOHEX_REQUIRE_SHARED_DATA();
   const std::vector<Expected> cases = {
-      {"cthead_256x256x113_int16be.raw", raw(256, 256, 113, ScalarType::i16, true), {256, 256, 113}, 0, 3272, 379.5421, 5e-5},
+      {"cthead_256x256x113_int16be.raw",
+       raw(256, 256, 113, ScalarType::i16, true),
+       {256, 256, 113},
+       0,
+       3272,
+       379.5421,
+       5e-5},
       {"headsq_64x64x93_int16le.raw", raw(64, 64, 93, ScalarType::i16), {64, 64, 93}, 0, 3926, 507.6873, 5e-5},
       {"HeadMRVolume.mhd", std::nullopt, {48, 62, 42}, 0, 255, 24.4682, 5e-5},
       {"avg152T1_RL_nifti.nii.gz", std::nullopt, {91, 109, 91}, 0, 255, 82.8972, 5e-5},
@@ -112,8 +116,7 @@ TEST(VolumeData, IronProtEqualsItsBytes) {
   const Volume v = read_volume(vol("ironProt.vtk"));
   const std::string bytes = io::read_file(vol("ironProt.vtk"));
   ASSERT_EQ(bytes.size(), 209u + v.size() + 1);
-  for (std::size_t i = 0; i < v.size(); ++i)
-    ASSERT_EQ(v.values[i], static_cast<unsigned char>(bytes[209 + i])) << i;
+  for (std::size_t i = 0; i < v.size(); ++i) ASSERT_EQ(v.values[i], static_cast<unsigned char>(bytes[209 + i])) << i;
 }
 
 TEST(VolumeData, HeadMrMhdEqualsItsRawFile) {
@@ -128,7 +131,8 @@ TEST(VolumeData, NiftiGzipAndDecompressedCopyAgree) {
   ISOHEX_REQUIRE_SHARED_DATA();
   const fs::path dir = scratch_dir();
   const fs::path nii = dir / "avg152.nii";
-  ASSERT_EQ(std::system(("gzip -dc '" + vol("avg152T1_RL_nifti.nii.gz").string() + "' > '" + nii.string() + "'").c_str()), 0);
+  ASSERT_EQ(
+      std::system(("gzip -dc '" + vol("avg152T1_RL_nifti.nii.gz").string() + "' > '" + nii.string() + "'").c_str()), 0);
   const Volume gz = read_volume(vol("avg152T1_RL_nifti.nii.gz"));
   const Volume plain = read_volume(nii);
   expect_identical(gz, plain, "avg152 .nii.gz vs .nii");
@@ -145,9 +149,10 @@ TEST(VolumeData, DetachedNrrdHeadersOverTheRawFiles) {
   ISOHEX_REQUIRE_SHARED_DATA();
   const fs::path dir = scratch_dir();
   // headsq quarter as VTK's own quarter.nhdr describes it, pointing at the derived raw file.
-  write_text(dir / "headsq.nhdr", "NRRD0004\ntype: short\ndimension: 3\nspace: 3D-left-handed\nsizes: 64 64 93\n"
-                                  "spacings: 3.2 3.2 1.5\nendian: little\nencoding: raw\ndata file: " +
-                                      vol("headsq_64x64x93_int16le.raw").string() + "\n");
+  write_text(dir / "headsq.nhdr",
+             "NRRD0004\ntype: short\ndimension: 3\nspace: 3D-left-handed\nsizes: 64 64 93\n"
+             "spacings: 3.2 3.2 1.5\nendian: little\nencoding: raw\ndata file: " +
+                 vol("headsq_64x64x93_int16le.raw").string() + "\n");
   const Volume headsq = read_volume(dir / "headsq.nhdr");
   EXPECT_EQ(headsq.spacing, Vec3(3.2, 3.2, 1.5));
   Volume ref = read_raw("headsq_64x64x93_int16le.raw", raw(64, 64, 93, ScalarType::i16));
@@ -159,23 +164,30 @@ TEST(VolumeData, DetachedNrrdHeadersOverTheRawFiles) {
   const std::string bytes = io::read_file(vol("headsq_64x64x93_int16le.raw"));
   for (int s = 1; s <= 93; ++s)
     write_text(dir / ("quarter." + std::to_string(s)), bytes.substr(static_cast<std::size_t>(s - 1) * 8192, 8192));
-  write_text(dir / "quarter.nhdr", "NRRD0004\ntype: short\ndimension: 3\nsizes: 64 64 93\nspacings: 3.2 3.2 1.5\n"
-                                   "endian: little\nencoding: raw\ndata file: quarter.%d 1 93 1\n");
+  write_text(dir / "quarter.nhdr",
+             "NRRD0004\ntype: short\ndimension: 3\nsizes: 64 64 93\nspacings: 3.2 3.2 1.5\n"
+             "endian: little\nencoding: raw\ndata file: quarter.%d 1 93 1\n");
   expect_identical(read_volume(dir / "quarter.nhdr"), ref, "quarter.%d series");
 
   // cthead is big-endian; a relative data file name resolves next to the header.
   fs::copy_file(vol("cthead_256x256x113_int16be.raw"), dir / "cthead.raw");
-  write_text(dir / "cthead.nhdr", "NRRD0005\n# comment\ntype: int16\ndimension: 3\nsizes: 256 256 113\n"
-                                  "endian: big\nencoding: raw\nmeta:=data\ndata file: cthead.raw\n");
+  write_text(dir / "cthead.nhdr",
+             "NRRD0005\n# comment\ntype: int16\ndimension: 3\nsizes: 256 256 113\n"
+             "endian: big\nencoding: raw\nmeta:=data\ndata file: cthead.raw\n");
   expect_identical(read_volume(dir / "cthead.nhdr"),
-                   read_raw("cthead_256x256x113_int16be.raw", raw(256, 256, 113, ScalarType::i16, true)), "cthead.nhdr");
+                   read_raw("cthead_256x256x113_int16be.raw", raw(256, 256, 113, ScalarType::i16, true)),
+                   "cthead.nhdr");
 
   // gzip-encoded data (compressed here by gzip itself) behind a detached header.
-  ASSERT_EQ(std::system(("gzip -c '" + vol("bucky_32x32x32_uint8.raw").string() + "' > '" + (dir / "bucky.raw.gz").string() + "'").c_str()), 0);
-  write_text(dir / "bucky.nhdr", "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 32 32 32\nencoding: gzip\n"
-                                 "data file: bucky.raw.gz\n");
-  expect_identical(read_volume(dir / "bucky.nhdr"), read_raw("bucky_32x32x32_uint8.raw", raw(32, 32, 32, ScalarType::u8)),
-                   "bucky gzip");
+  ASSERT_EQ(std::system(("gzip -c '" + vol("bucky_32x32x32_uint8.raw").string() + "' > '" +
+                         (dir / "bucky.raw.gz").string() + "'")
+                            .c_str()),
+            0);
+  write_text(dir / "bucky.nhdr",
+             "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 32 32 32\nencoding: gzip\n"
+             "data file: bucky.raw.gz\n");
+  expect_identical(read_volume(dir / "bucky.nhdr"),
+                   read_raw("bucky_32x32x32_uint8.raw", raw(32, 32, 32, ScalarType::u8)), "bucky gzip");
 }
 
 TEST(VolumeData, RoundTripsThroughNrrdAndVtiAreBitExact) {

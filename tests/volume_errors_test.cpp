@@ -36,7 +36,8 @@ void expect_error(const fs::path& file, const std::vector<std::string>& parts, V
 
 std::string gzip_of(const fs::path& dir, const std::string& bytes) {
   write(dir / "in.bin", bytes);
-  EXPECT_EQ(std::system(("gzip -c '" + (dir / "in.bin").string() + "' > '" + (dir / "in.gz").string() + "'").c_str()), 0);
+  EXPECT_EQ(std::system(("gzip -c '" + (dir / "in.bin").string() + "' > '" + (dir / "in.gz").string() + "'").c_str()),
+            0);
   return io::read_file(dir / "in.gz");
 }
 
@@ -77,10 +78,14 @@ TEST(VolumeErrors, NrrdHeaders) {
       {"type.nrrd", nrrd("type: quaternion\ndimension: 3\nencoding: raw\nsizes: 5 4 3\n\n") + kData, {"field 'type'"}},
       {"int64.nrrd", nrrd("type: int64\ndimension: 3\nencoding: raw\nsizes: 5 4 3\n\n") + kData, {"field 'type'"}},
       {"dim.nrrd", nrrd("type: uchar\ndimension: 4\nencoding: raw\nsizes: 5 4 3 1\n\n") + kData, {"field 'dimension'"}},
-      {"endian.nrrd", nrrd("type: short\ndimension: 3\nencoding: raw\nsizes: 5 4 3\n\n") + kData + kData, {"field 'endian'"}},
+      {"endian.nrrd",
+       nrrd("type: short\ndimension: 3\nencoding: raw\nsizes: 5 4 3\n\n") + kData + kData,
+       {"field 'endian'"}},
       {"enc.nrrd", nrrd("type: uchar\ndimension: 3\nencoding: bzip2\nsizes: 5 4 3\n\n") + kData, {"field 'encoding'"}},
       {"short.nrrd", nrrd(ok + "sizes: 5 4 4\n\n") + kData, {"truncated, or the header lies"}},
-      {"dirs.nrrd", nrrd(ok + "sizes: 5 4 3\nspace directions: none (0,1,0) (0,0,1)\n\n") + kData, {"field 'space directions'"}},
+      {"dirs.nrrd",
+       nrrd(ok + "sizes: 5 4 3\nspace directions: none (0,1,0) (0,0,1)\n\n") + kData,
+       {"field 'space directions'"}},
       {"spacing.nrrd", nrrd(ok + "sizes: 5 4 3\nspacings: 1 0 1\n\n") + kData, {"field 'spacings'", "positive"}},
       {"magic.nrrd", "P5\n5 4\n255\n" + kData, {"line 1", "NRRD"}},
       {"nodata.nhdr", nrrd(ok + "sizes: 5 4 3\ndata file: nowhere.raw\n"), {"field 'data file'", "does not exist"}},
@@ -179,9 +184,9 @@ TEST(VolumeErrors, NiftiHeaders) {
 TEST(VolumeErrors, VtiHeadersAndData) {
   const fs::path d = scratch_dir();
   const auto vti = [](const std::string& whole, const std::string& type, const std::string& data) {
-    return "<VTKFile type=\"ImageData\" version=\"1.0\"><ImageData WholeExtent=\"" + whole +
-           "\"><Piece Extent=\"" + whole + "\"><PointData><DataArray type=\"" + type +
-           "\" format=\"ascii\">" + data + "</DataArray></PointData></Piece></ImageData></VTKFile>\n";
+    return "<VTKFile type=\"ImageData\" version=\"1.0\"><ImageData WholeExtent=\"" + whole + "\"><Piece Extent=\"" +
+           whole + "\"><PointData><DataArray type=\"" + type + "\" format=\"ascii\">" + data +
+           "</DataArray></PointData></Piece></ImageData></VTKFile>\n";
   };
   write(d / "empty.vti", vti("0 -1 0 3 0 2", "UInt8", "1"));
   expect_error(d / "empty.vti", {"WholeExtent", "positive"});
@@ -224,11 +229,13 @@ TEST(VolumeErrors, MemoryLimitRefusesBeforeAllocating) {
   // 10^15 declared points (4 PB as float) and no data: refused at once, from each format.
   write(d / "big.nrrd", nrrd("type: uchar\ndimension: 3\nencoding: raw\nsizes: 100000 100000 100000\n\n"));
   write(d / "big.mha", "NDims = 3\nDimSize = 100000 100000 100000\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n");
-  write(d / "big.vtk", "# vtk DataFile Version 3.0\nt\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 100000 100000 "
-                       "100000\nPOINT_DATA 1000000000000000\nSCALARS s unsigned_char\n");
-  write(d / "big.vti", "<VTKFile type=\"ImageData\"><ImageData WholeExtent=\"0 99999 0 99999 0 99999\"><Piece "
-                       "Extent=\"0 99999 0 99999 0 99999\"><PointData><DataArray type=\"UInt8\" format=\"ascii\">1"
-                       "</DataArray></PointData></Piece></ImageData></VTKFile>");
+  write(d / "big.vtk",
+        "# vtk DataFile Version 3.0\nt\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 100000 100000 "
+        "100000\nPOINT_DATA 1000000000000000\nSCALARS s unsigned_char\n");
+  write(d / "big.vti",
+        "<VTKFile type=\"ImageData\"><ImageData WholeExtent=\"0 99999 0 99999 0 99999\"><Piece "
+        "Extent=\"0 99999 0 99999 0 99999\"><PointData><DataArray type=\"UInt8\" format=\"ascii\">1"
+        "</DataArray></PointData></Piece></ImageData></VTKFile>");
   write(d / "big.nii", nifti(2, 8, 30000) + kData);  // 30000 x 4 x 3 fits int16; limit set below
   const auto start = std::chrono::steady_clock::now();
   for (const char* f : {"big.nrrd", "big.mha", "big.vtk", "big.vti"}) expect_error(d / f, {"limit", "--max-memory"});

@@ -29,10 +29,13 @@ double field(Index i, Index j, Index k, ScalarType t) {
   switch (t) {
     case ScalarType::u8:
     case ScalarType::u16:
-    case ScalarType::u32: return n;
+    case ScalarType::u32:
+      return n;
     case ScalarType::f32:
-    case ScalarType::f64: return n * 0.25 - 7.5;
-    default: return n - 30;
+    case ScalarType::f64:
+      return n * 0.25 - 7.5;
+    default:
+      return n - 30;
   }
 }
 
@@ -47,14 +50,22 @@ void put(std::string& out, double v, bool big) {
 
 void put_value(std::string& out, double v, ScalarType t, bool big) {
   switch (t) {
-    case ScalarType::u8: return put<std::uint8_t>(out, v, big);
-    case ScalarType::i8: return put<std::int8_t>(out, v, big);
-    case ScalarType::u16: return put<std::uint16_t>(out, v, big);
-    case ScalarType::i16: return put<std::int16_t>(out, v, big);
-    case ScalarType::u32: return put<std::uint32_t>(out, v, big);
-    case ScalarType::i32: return put<std::int32_t>(out, v, big);
-    case ScalarType::f32: return put<float>(out, v, big);
-    case ScalarType::f64: return put<double>(out, v, big);
+    case ScalarType::u8:
+      return put<std::uint8_t>(out, v, big);
+    case ScalarType::i8:
+      return put<std::int8_t>(out, v, big);
+    case ScalarType::u16:
+      return put<std::uint16_t>(out, v, big);
+    case ScalarType::i16:
+      return put<std::int16_t>(out, v, big);
+    case ScalarType::u32:
+      return put<std::uint32_t>(out, v, big);
+    case ScalarType::i32:
+      return put<std::int32_t>(out, v, big);
+    case ScalarType::f32:
+      return put<float>(out, v, big);
+    case ScalarType::f64:
+      return put<double>(out, v, big);
   }
 }
 
@@ -79,7 +90,9 @@ void write(const fs::path& file, const std::string& bytes) { std::ofstream(file,
 
 std::string gzip(const fs::path& dir, const std::string& bytes) {
   write(dir / "plain.bin", bytes);
-  EXPECT_EQ(std::system(("gzip -c '" + (dir / "plain.bin").string() + "' > '" + (dir / "plain.gz").string() + "'").c_str()), 0);
+  EXPECT_EQ(
+      std::system(("gzip -c '" + (dir / "plain.bin").string() + "' > '" + (dir / "plain.gz").string() + "'").c_str()),
+      0);
   std::ifstream in(dir / "plain.gz", std::ios::binary);
   return {std::istreambuf_iterator<char>(in), {}};
 }
@@ -98,7 +111,12 @@ void expect_field(const Volume& v, ScalarType t, std::array<Index, 3> dims, Map 
 }
 
 void expect_field(const Volume& v, ScalarType t, const std::string& what) {
-  expect_field(v, t, {NX, NY, NZ}, [](Index i, Index j, Index k) { return std::array<Index, 3>{i, j, k}; }, what);
+  expect_field(
+      v, t, {NX, NY, NZ},
+      [](Index i, Index j, Index k) {
+        return std::array<Index, 3>{i, j, k};
+      },
+      what);
 }
 
 const char* nrrd_type(ScalarType t) {
@@ -117,7 +135,8 @@ TEST(VolumeNrrd, AttachedRawEveryTypeAndByteOrder) {
   for (ScalarType t : kAllTypes)
     for (bool big : {false, true}) {
       const fs::path f = dir / "v.nrrd";
-      write(f, nrrd_head(t, std::string("endian: ") + (big ? "big" : "little") + "\nencoding: raw\n\n") + encode(t, big));
+      write(f,
+            nrrd_head(t, std::string("endian: ") + (big ? "big" : "little") + "\nencoding: raw\n\n") + encode(t, big));
       expect_field(read_volume(f), t, std::string(scalar_type_name(t)) + (big ? " big" : " little"));
     }
 }
@@ -125,7 +144,8 @@ TEST(VolumeNrrd, AttachedRawEveryTypeAndByteOrder) {
 TEST(VolumeNrrd, GzipAsciiAndSkips) {
   const fs::path dir = scratch_dir();
   const ScalarType t = ScalarType::i16;
-  write(dir / "gz.nrrd", nrrd_head(t, "endian: big\nencoding: gzip\nspacings: 0.5 1 2\n\n") + gzip(dir, encode(t, true)));
+  write(dir / "gz.nrrd",
+        nrrd_head(t, "endian: big\nencoding: gzip\nspacings: 0.5 1 2\n\n") + gzip(dir, encode(t, true)));
   const Volume gz = read_volume(dir / "gz.nrrd");
   expect_field(gz, t, "gzip");
   EXPECT_EQ(gz.spacing, Vec3(0.5, 1, 2));
@@ -135,7 +155,8 @@ TEST(VolumeNrrd, GzipAsciiAndSkips) {
 
   // byte skip, line skip, and byte skip -1 (the data is the end of the file).
   write(dir / "skip.raw", "junk line\nmore\n0123456" + encode(t, false));
-  write(dir / "bytes.nhdr", nrrd_head(t, "endian: little\nencoding: raw\nline skip: 2\nbyte skip: 7\ndata file: skip.raw\n"));
+  write(dir / "bytes.nhdr",
+        nrrd_head(t, "endian: little\nencoding: raw\nline skip: 2\nbyte skip: 7\ndata file: skip.raw\n"));
   expect_field(read_volume(dir / "bytes.nhdr"), t, "line and byte skip");
   write(dir / "end.nhdr", nrrd_head(t, "endian: little\nencoding: raw\nbyte skip: -1\ndatafile: skip.raw\n"));
   expect_field(read_volume(dir / "end.nhdr"), t, "byte skip -1");
@@ -157,21 +178,35 @@ TEST(VolumeNrrd, SpaceDirectionsFlipPermuteOrRotate) {
   const ScalarType t = ScalarType::u8;
   const std::string data = encode(t, false);
   // x runs backwards from 10: the grid is flipped so that spacing is positive.
-  write(dir / "flip.nrrd", nrrd_head(t, "encoding: raw\nspace dimension: 3\nspace directions: (-2,0,0) (0,3,0) "
-                                        "(0,0,1.5)\nspace origin: (10,20,30)\n\n") + data);
+  write(dir / "flip.nrrd", nrrd_head(t,
+                                     "encoding: raw\nspace dimension: 3\nspace directions: (-2,0,0) (0,3,0) "
+                                     "(0,0,1.5)\nspace origin: (10,20,30)\n\n") +
+                               data);
   const Volume flip = read_volume(dir / "flip.nrrd");
-  expect_field(flip, t, {NX, NY, NZ}, [](Index i, Index j, Index k) { return std::array<Index, 3>{NX - 1 - i, j, k}; },
-               "flip");
+  expect_field(
+      flip, t, {NX, NY, NZ},
+      [](Index i, Index j, Index k) {
+        return std::array<Index, 3>{NX - 1 - i, j, k};
+      },
+      "flip");
   EXPECT_EQ(flip.spacing, Vec3(2, 3, 1.5));
   EXPECT_EQ(flip.origin, Vec3(2, 20, 30));
   // Grid axis 0 runs along world y, axis 1 along world x: the values are transposed.
-  write(dir / "perm.nrrd", nrrd_head(t, "encoding: raw\nspace: RAS\nspace directions: (0,2,0) (1,0,0) (0,0,1)\n\n") + data);
+  write(dir / "perm.nrrd",
+        nrrd_head(t, "encoding: raw\nspace: RAS\nspace directions: (0,2,0) (1,0,0) (0,0,1)\n\n") + data);
   const Volume perm = read_volume(dir / "perm.nrrd");
-  expect_field(perm, t, {NY, NX, NZ}, [](Index i, Index j, Index k) { return std::array<Index, 3>{j, i, k}; }, "perm");
+  expect_field(
+      perm, t, {NY, NX, NZ},
+      [](Index i, Index j, Index k) {
+        return std::array<Index, 3>{j, i, k};
+      },
+      "perm");
   EXPECT_EQ(perm.spacing, Vec3(1, 2, 1));
   // A rotated grid keeps its own axes and the lengths of its steps.
-  write(dir / "rot.nrrd", nrrd_head(t, "encoding: raw\nspace directions: (0.6,0.8,0) (-0.8,0.6,0) (0,0,2)\n"
-                                       "space origin: (1,2,3)\n\n") + data);
+  write(dir / "rot.nrrd", nrrd_head(t,
+                                    "encoding: raw\nspace directions: (0.6,0.8,0) (-0.8,0.6,0) (0,0,2)\n"
+                                    "space origin: (1,2,3)\n\n") +
+                              data);
   const Volume rot = read_volume(dir / "rot.nrrd");
   expect_field(rot, t, "rotated");
   EXPECT_NEAR((rot.spacing - Vec3(1, 1, 2)).norm(), 0, 1e-15);
@@ -180,46 +215,60 @@ TEST(VolumeNrrd, SpaceDirectionsFlipPermuteOrRotate) {
 
 TEST(VolumeMetaImage, LocalSeparateCompressedAscii) {
   const fs::path dir = scratch_dir();
-  write(dir / "msb.mha", "ObjectType = Image\nNDims = 3\nDimSize = 5 4 3\nElementType = MET_USHORT\n"
-                         "ElementByteOrderMSB = True\nElementSpacing = 0.5 0.25 2\nOffset = -1 2.5 3\n"
-                         "ElementDataFile = LOCAL\n" + encode(ScalarType::u16, true));
+  write(dir / "msb.mha",
+        "ObjectType = Image\nNDims = 3\nDimSize = 5 4 3\nElementType = MET_USHORT\n"
+        "ElementByteOrderMSB = True\nElementSpacing = 0.5 0.25 2\nOffset = -1 2.5 3\n"
+        "ElementDataFile = LOCAL\n" +
+            encode(ScalarType::u16, true));
   const Volume msb = read_volume(dir / "msb.mha");
   expect_field(msb, ScalarType::u16, "MSB LOCAL");
   EXPECT_EQ(msb.spacing, Vec3(0.5, 0.25, 2));
   EXPECT_EQ(msb.origin, Vec3(-1, 2.5, 3));
 
   write(dir / "data.bin", "HEADER!" + encode(ScalarType::f64, false));
-  write(dir / "sep.mhd", "NDims = 3\nDimSize = 5 4 3\nElementType = MET_DOUBLE\nElementSize = 3 3 3\n"
-                         "HeaderSize = 7\nBinaryDataByteOrderMSB = False\nElementDataFile = data.bin\n");
+  write(dir / "sep.mhd",
+        "NDims = 3\nDimSize = 5 4 3\nElementType = MET_DOUBLE\nElementSize = 3 3 3\n"
+        "HeaderSize = 7\nBinaryDataByteOrderMSB = False\nElementDataFile = data.bin\n");
   const Volume sep = read_volume(dir / "sep.mhd");
   expect_field(sep, ScalarType::f64, "separate file");
   EXPECT_EQ(sep.spacing, Vec3(3, 3, 3));
 
-  write(dir / "z.mha", "NDims = 3\nDimSize = 5 4 3\nElementType = MET_INT\nCompressedData = True\n"
-                       "ElementDataFile = LOCAL\n" + gzip(dir, encode(ScalarType::i32, false)));
+  write(dir / "z.mha",
+        "NDims = 3\nDimSize = 5 4 3\nElementType = MET_INT\nCompressedData = True\n"
+        "ElementDataFile = LOCAL\n" +
+            gzip(dir, encode(ScalarType::i32, false)));
   expect_field(read_volume(dir / "z.mha"), ScalarType::i32, "compressed");
 
-  write(dir / "t.mha", "NDims = 3\nDimSize = 5 4 3\nElementType = MET_CHAR\nBinaryData = False\n"
-                       "TransformMatrix = 1 0 0 0 -1 0 0 0 1\nElementDataFile = LOCAL\n" + ascii(ScalarType::i8));
+  write(dir / "t.mha",
+        "NDims = 3\nDimSize = 5 4 3\nElementType = MET_CHAR\nBinaryData = False\n"
+        "TransformMatrix = 1 0 0 0 -1 0 0 0 1\nElementDataFile = LOCAL\n" +
+            ascii(ScalarType::i8));
   const Volume t = read_volume(dir / "t.mha");
-  expect_field(t, ScalarType::i8, {NX, NY, NZ}, [](Index i, Index j, Index k) { return std::array<Index, 3>{i, NY - 1 - j, k}; },
-               "ascii, y flipped by TransformMatrix");
+  expect_field(
+      t, ScalarType::i8, {NX, NY, NZ},
+      [](Index i, Index j, Index k) {
+        return std::array<Index, 3>{i, NY - 1 - j, k};
+      },
+      "ascii, y flipped by TransformMatrix");
   EXPECT_EQ(t.origin, Vec3(0, -3, 0));
 }
 
 TEST(VolumeLegacyVtk, AsciiAndBinary) {
   const fs::path dir = scratch_dir();
-  write(dir / "a.vtk", "# vtk DataFile Version 3.0\nsome title\nASCII\nDATASET STRUCTURED_POINTS\n"
-                       "DIMENSIONS 5 4 3\nSPACING 0.5 1 2\nORIGIN 1 2 3\nPOINT_DATA 60\nSCALARS s short 1\n"
-                       "LOOKUP_TABLE default\n" + ascii(ScalarType::i16));
+  write(dir / "a.vtk",
+        "# vtk DataFile Version 3.0\nsome title\nASCII\nDATASET STRUCTURED_POINTS\n"
+        "DIMENSIONS 5 4 3\nSPACING 0.5 1 2\nORIGIN 1 2 3\nPOINT_DATA 60\nSCALARS s short 1\n"
+        "LOOKUP_TABLE default\n" +
+            ascii(ScalarType::i16));
   const Volume a = read_volume(dir / "a.vtk");
   expect_field(a, ScalarType::i16, "ascii");
   EXPECT_EQ(a.spacing, Vec3(0.5, 1, 2));
   EXPECT_EQ(a.origin, Vec3(1, 2, 3));
 
-  write(dir / "b.vtk", "# vtk DataFile Version 2.0\nt\nBINARY\nDATASET STRUCTURED_POINTS\nORIGIN 0 0 0\n"
-                       "ASPECT_RATIO 2 2 2\nDIMENSIONS 5 4 3\nPOINT_DATA 60\nSCALARS s double\n" +
-                           encode(ScalarType::f64, true) + "\n");
+  write(dir / "b.vtk",
+        "# vtk DataFile Version 2.0\nt\nBINARY\nDATASET STRUCTURED_POINTS\nORIGIN 0 0 0\n"
+        "ASPECT_RATIO 2 2 2\nDIMENSIONS 5 4 3\nPOINT_DATA 60\nSCALARS s double\n" +
+            encode(ScalarType::f64, true) + "\n");
   const Volume b = read_volume(dir / "b.vtk");
   expect_field(b, ScalarType::f64, "binary without LOOKUP_TABLE");
   EXPECT_EQ(b.spacing, Vec3(2, 2, 2));
@@ -228,8 +277,10 @@ TEST(VolumeLegacyVtk, AsciiAndBinary) {
   std::string bytes = encode(ScalarType::u8, true);
   bytes[0] = '\n';
   bytes[1] = ' ';
-  write(dir / "c.vtk", "# vtk DataFile Version 3.0\nt\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 5 4 3\n"
-                       "POINT_DATA 60\nSCALARS s unsigned_char\n" + bytes);
+  write(dir / "c.vtk",
+        "# vtk DataFile Version 3.0\nt\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 5 4 3\n"
+        "POINT_DATA 60\nSCALARS s unsigned_char\n" +
+            bytes);
   const Volume c = read_volume(dir / "c.vtk");
   EXPECT_EQ(c.at(0, 0, 0), '\n');
   EXPECT_EQ(c.at(1, 0, 0), ' ');
@@ -241,16 +292,30 @@ namespace {
 /// A NIfTI-1 header for the test field, in either byte order.
 std::string nifti_header(ScalarType t, bool big, float slope, float inter, int sform, int qform) {
   std::string h(352, '\0');
-  auto i32 = [&](std::size_t at, std::int32_t v) { std::string s; put<std::int32_t>(s, v, big); h.replace(at, 4, s); };
-  auto i16 = [&](std::size_t at, std::int16_t v) { std::string s; put<std::int16_t>(s, v, big); h.replace(at, 2, s); };
-  auto f32 = [&](std::size_t at, float v) { std::string s; put<float>(s, v, big); h.replace(at, 4, s); };
+  auto i32 = [&](std::size_t at, std::int32_t v) {
+    std::string s;
+    put<std::int32_t>(s, v, big);
+    h.replace(at, 4, s);
+  };
+  auto i16 = [&](std::size_t at, std::int16_t v) {
+    std::string s;
+    put<std::int16_t>(s, v, big);
+    h.replace(at, 2, s);
+  };
+  auto f32 = [&](std::size_t at, float v) {
+    std::string s;
+    put<float>(s, v, big);
+    h.replace(at, 4, s);
+  };
   i32(0, 348);
   const std::int16_t dim[8] = {3, NX, NY, NZ, 1, 1, 1, 1};
   for (int a = 0; a < 8; ++a) i16(40 + 2 * a, dim[a]);
   const std::int16_t codes[] = {2, 256, 512, 4, 768, 8, 16, 64};
   i16(70, codes[static_cast<int>(t)]);
-  i16(72, static_cast<std::int16_t>(8 * (t == ScalarType::f64 ? 8 : t == ScalarType::u8 || t == ScalarType::i8 ? 1
-                                                           : t == ScalarType::u16 || t == ScalarType::i16 ? 2 : 4)));
+  i16(72, static_cast<std::int16_t>(8 * (t == ScalarType::f64                           ? 8
+                                         : t == ScalarType::u8 || t == ScalarType::i8   ? 1
+                                         : t == ScalarType::u16 || t == ScalarType::i16 ? 2
+                                                                                        : 4)));
   const float pixdim[8] = {qform ? -1.0f : 1.0f, 0.5f, 1, 2, 1, 1, 1, 1};
   for (int a = 0; a < 8; ++a) f32(76 + 4 * a, pixdim[a]);
   f32(108, 352);
@@ -286,15 +351,23 @@ TEST(VolumeNifti, ByteOrdersScalingAndTransforms) {
   // The sform (-3 mm along x from 40) wins over the qform: x is flipped.
   write(dir / "sf.nii", nifti_header(ScalarType::u8, false, 0, 0, 2, 1) + encode(ScalarType::u8, false));
   const Volume sf = read_volume(dir / "sf.nii");
-  expect_field(sf, ScalarType::u8, {NX, NY, NZ}, [](Index i, Index j, Index k) { return std::array<Index, 3>{NX - 1 - i, j, k}; },
-               "sform flip");
+  expect_field(
+      sf, ScalarType::u8, {NX, NY, NZ},
+      [](Index i, Index j, Index k) {
+        return std::array<Index, 3>{NX - 1 - i, j, k};
+      },
+      "sform flip");
   EXPECT_EQ(sf.spacing, Vec3(3, 1, 2));
   EXPECT_EQ(sf.origin, Vec3(28, -5, 7));
   // The qform alone: identity rotation, qfac -1 (pixdim[0]) reverses z, offset (1, 2, 3).
   write(dir / "qf.nii.gz", gzip(dir, nifti_header(ScalarType::u8, false, 0, 0, 0, 1) + encode(ScalarType::u8, false)));
   const Volume qf = read_volume(dir / "qf.nii.gz");
-  expect_field(qf, ScalarType::u8, {NX, NY, NZ}, [](Index i, Index j, Index k) { return std::array<Index, 3>{i, j, NZ - 1 - k}; },
-               "qform qfac -1");
+  expect_field(
+      qf, ScalarType::u8, {NX, NY, NZ},
+      [](Index i, Index j, Index k) {
+        return std::array<Index, 3>{i, j, NZ - 1 - k};
+      },
+      "qform qfac -1");
   EXPECT_EQ(qf.spacing, Vec3(0.5, 1, 2));
   EXPECT_EQ(qf.origin, Vec3(1, 2, 3 - 2 * (NZ - 1)));
 }
@@ -305,15 +378,23 @@ TEST(VolumeVti, PiecesAsciiAndExtentOffset) {
   std::string slab0, slab1;
   for (Index k = 0; k < NZ; ++k)
     for (Index j = 0; j < NY; ++j)
-      for (Index i = 0; i < NX; ++i) (k < 2 ? slab0 : slab1) += std::to_string(static_cast<int>(field(i, j, k, ScalarType::i16))) + " ";
-  write(dir / "p.vti", "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"BigEndian\">\n"
-                       "<ImageData WholeExtent=\"2 6 0 3 0 2\" Origin=\"1 0 0\" Spacing=\"0.5 1 1\">\n"
-                       "<Piece Extent=\"2 6 0 3 0 1\"><PointData Scalars=\"s\">\n"
-                       "<DataArray type=\"Float32\" Name=\"other\" format=\"ascii\">" + std::string(120, '7') + "</DataArray>\n"
-                       "<DataArray type=\"Int16\" Name=\"s\" format=\"ascii\">" + slab0 + "</DataArray></PointData></Piece>\n"
-                       "<Piece Extent=\"2 6 0 3 2 2\"><PointData Scalars=\"s\">\n"
-                       "<DataArray type=\"Int16\" Name=\"s\" format=\"ascii\">" + slab1 + "</DataArray></PointData></Piece>\n"
-                       "</ImageData></VTKFile>\n");
+      for (Index i = 0; i < NX; ++i)
+        (k < 2 ? slab0 : slab1) += std::to_string(static_cast<int>(field(i, j, k, ScalarType::i16))) + " ";
+  write(dir / "p.vti",
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"BigEndian\">\n"
+        "<ImageData WholeExtent=\"2 6 0 3 0 2\" Origin=\"1 0 0\" Spacing=\"0.5 1 1\">\n"
+        "<Piece Extent=\"2 6 0 3 0 1\"><PointData Scalars=\"s\">\n"
+        "<DataArray type=\"Float32\" Name=\"other\" format=\"ascii\">" +
+            std::string(120, '7') +
+            "</DataArray>\n"
+            "<DataArray type=\"Int16\" Name=\"s\" format=\"ascii\">" +
+            slab0 +
+            "</DataArray></PointData></Piece>\n"
+            "<Piece Extent=\"2 6 0 3 2 2\"><PointData Scalars=\"s\">\n"
+            "<DataArray type=\"Int16\" Name=\"s\" format=\"ascii\">" +
+            slab1 +
+            "</DataArray></PointData></Piece>\n"
+            "</ImageData></VTKFile>\n");
   const Volume v = read_volume(dir / "p.vti");
   expect_field(v, ScalarType::i16, "two pieces");
   EXPECT_EQ(v.origin, Vec3(2, 0, 0));  // Origin + 2 * 0.5 along x

@@ -6,9 +6,9 @@
 /// (sandialabs/verdict, `V_HexMetric.cpp`, `V_QuadMetric.cpp`) operation for operation, so
 /// the values agree with Verdict bit for bit. (Transcribed from the 1.4.4 sources, the newest
 /// we could read; they match the 1.4.5 step-by-step description in
-/// shared/notes/verdict-hex-scaled-jacobian.md and Verdict's own unit tests.) Where Verdict reports a degenerate element it returns
-/// kVerdictDblMax (1e30); use is_degenerate() so that such values are never taken for good
-/// quality.
+/// shared/notes/verdict-hex-scaled-jacobian.md and Verdict's own unit tests.) Where Verdict
+/// reports a degenerate element it returns kVerdictDblMax (1e30); use is_degenerate() so that
+/// such values are never taken for good quality.
 ///
 /// \par Normalisation and degeneracy
 /// Verdict 1.4.4+ first translates the 8 corners to their centroid and divides them by their
@@ -55,7 +55,8 @@ enum class HexMetric {
   scaled_jacobian,  ///< Verdict hex_scaled_jacobian: min over centre + 8 corners of det/(|x1||x2||x3|)
   jacobian,         ///< Verdict hex_jacobian: min corner determinant (centre det / 64 included)
   edge_ratio,       ///< Verdict hex_edge_ratio: longest / shortest edge
-  mean_ratio,       ///< Knupp's mean ratio: mean over the 8 corners of 3 det(A)^(2/3) / |A|_F^2 (0 if det <= 0)
+  mean_ratio,       ///< Knupp's mean ratio: mean over the 8 corners of 3 det(A)^(2/3) / |A|_F^2
+                    ///< (a corner with det <= 0 counts 0)
   shape,            ///< Verdict hex_shape: min over the 8 corners of the same corner mean ratio
   skew,             ///< Verdict hex_skew
   taper,            ///< Verdict hex_taper

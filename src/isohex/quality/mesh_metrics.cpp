@@ -1,13 +1,13 @@
 // Metrics over whole meshes: oneTBB over blocks of hexes, and a batched scaled-Jacobian kernel.
 //
 // The batched kernel computes the same IEEE operations as scaled_jacobian() in the same order
-// (Verdict's), only on W hexes side by side in structure-of-arrays form so that the compiler
-// turns every step into packed SIMD instructions. Packed and scalar IEEE arithmetic round
-// identically, the library is built with -ffp-contract=off (no FMA), and min/max are written
-// as the `a < b ? a : b` selects Verdict uses, so the fast path returns the very bits of the
-// scalar one (tested). The kernel is compiled once per instruction set (AVX-512, AVX2, baseline
-// SSE2) and GCC's function multiversioning picks one when the program loads, so the binary
-// stays portable and no -march flag is needed.
+// (Verdict's), only on kLanes (8) hexes side by side in structure-of-arrays form, so that the
+// compiler turns every step into packed SIMD instructions. Packed and scalar IEEE arithmetic
+// round identically, the library is built with -ffp-contract=off (no FMA), and min/max are
+// written as the `a < b ? a : b` selects Verdict uses, so the fast path returns the very bits
+// of the scalar one (tested). The kernel is compiled once per instruction set (AVX-512, AVX2,
+// baseline SSE2) and GCC's function multiversioning picks one when the program loads, so the
+// binary stays portable and no -march flag is needed.
 
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/verdict_vector.hpp"
@@ -17,7 +17,6 @@
 
 #include <cmath>
 #include <cstddef>
-#include <cstdint>
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
 #define ISOHEX_HAVE_FMV 1
@@ -40,16 +39,19 @@ constexpr std::size_t kGrain = 4096;
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Eigen::Vector3d must be unpadded");
 
 /// One triple of one lane: Verdict's determinant and the product of the squared lengths
-/// (whose square root divides it), and whether an edge vector has collapsed.
+/// (whose square root divides it). `shortest` keeps the smallest squared length seen: Verdict
+/// returns 1e30 as soon as one is <= VERDICT_DBL_MIN, i.e. iff the smallest is (a NaN length
+/// fails that test in Verdict and never enters the minimum here).
 [[gnu::always_inline]] inline void sj_triple(double ax, double ay, double az, double bx, double by,
                                              double bz, double cx, double cy, double cz,
-                                             double& jac, double& prod, std::int64_t& degenerate) {
+                                             double& jac, double& prod, double& shortest) {
   jac = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx);
   const double l1 = ax * ax + ay * ay + az * az;
   const double l2 = bx * bx + by * by + bz * bz;
   const double l3 = cx * cx + cy * cy + cz * cz;
-  degenerate |= static_cast<std::int64_t>((l1 <= kVerdictDblMin) | (l2 <= kVerdictDblMin) |
-                                          (l3 <= kVerdictDblMin));
+  shortest = l1 < shortest ? l1 : shortest;
+  shortest = l2 < shortest ? l2 : shortest;
+  shortest = l3 < shortest ? l3 : shortest;
   prod = l1 * l2 * l3;
 }
 
@@ -91,13 +93,13 @@ struct SqrtScalar {
 template <int K>
 [[gnu::always_inline]] inline void sj_corner(const double (&qx)[8][kLanes], const double (&qy)[8][kLanes],
                                              const double (&qz)[8][kLanes], double (&jac)[kLanes],
-                                             double (&prod)[kLanes], std::int64_t (&degenerate)[kLanes]) {
+                                             double (&prod)[kLanes], double (&shortest)[kLanes]) {
   constexpr int a = kCornerNeighbors[K][0], b = kCornerNeighbors[K][1], c = kCornerNeighbors[K][2];
   for (int l = 0; l < kLanes; ++l) {
     sj_triple(qx[a][l] - qx[K][l], qy[a][l] - qy[K][l], qz[a][l] - qz[K][l],  //
               qx[b][l] - qx[K][l], qy[b][l] - qy[K][l], qz[b][l] - qz[K][l],  //
               qx[c][l] - qx[K][l], qy[c][l] - qy[K][l], qz[c][l] - qz[K][l],  //
-              jac[l], prod[l], degenerate[l]);
+              jac[l], prod[l], shortest[l]);
   }
 }
 
@@ -113,7 +115,7 @@ template <class Sqrt>
   alignas(64) double lox[kLanes], loy[kLanes], loz[kLanes], hix[kLanes], hiy[kLanes], hiz[kLanes];
   alignas(64) double cx[kLanes], cy[kLanes], cz[kLanes], len[kLanes];
   alignas(64) double jac[9][kLanes], prod[9][kLanes];  // centre, then corners 0..7
-  alignas(64) std::int64_t degenerate[kLanes];
+  alignas(64) double shortest[kLanes];  // smallest squared edge-vector length
   for (std::size_t h0 = begin; h0 < end; h0 += kLanes) {
     const std::size_t n = end - h0 < kLanes ? end - h0 : kLanes;
     for (int l = 0; l < kLanes; ++l) {
@@ -157,7 +159,7 @@ template <class Sqrt>
       cy[l] = tiny ? 0.0 : cy[l] / 8.0;
       cz[l] = tiny ? 0.0 : cz[l] / 8.0;
       len[l] = tiny ? 1.0 : len[l];
-      degenerate[l] = 0;
+      shortest[l] = kDblMax;
     }
     for (int i = 0; i < 8; ++i) {
       for (int l = 0; l < kLanes; ++l) {
@@ -172,25 +174,25 @@ template <class Sqrt>
                 sj_axis(qz, l, 1, 0, 2, 3, 5, 4, 6, 7), sj_axis(qx, l, 2, 0, 3, 1, 6, 4, 7, 5),
                 sj_axis(qy, l, 2, 0, 3, 1, 6, 4, 7, 5), sj_axis(qz, l, 2, 0, 3, 1, 6, 4, 7, 5),
                 sj_axis(qx, l, 4, 0, 5, 1, 6, 2, 7, 3), sj_axis(qy, l, 4, 0, 5, 1, 6, 2, 7, 3),
-                sj_axis(qz, l, 4, 0, 5, 1, 6, 2, 7, 3), jac[0][l], prod[0][l], degenerate[l]);
+                sj_axis(qz, l, 4, 0, 5, 1, 6, 2, 7, 3), jac[0][l], prod[0][l], shortest[l]);
     }
     Sqrt::lanes(prod[0]);
     // The eight corners, unrolled at compile time so that every index is a constant.
-    sj_corner<0>(qx, qy, qz, jac[1], prod[1], degenerate);
+    sj_corner<0>(qx, qy, qz, jac[1], prod[1], shortest);
     Sqrt::lanes(prod[1]);
-    sj_corner<1>(qx, qy, qz, jac[2], prod[2], degenerate);
+    sj_corner<1>(qx, qy, qz, jac[2], prod[2], shortest);
     Sqrt::lanes(prod[2]);
-    sj_corner<2>(qx, qy, qz, jac[3], prod[3], degenerate);
+    sj_corner<2>(qx, qy, qz, jac[3], prod[3], shortest);
     Sqrt::lanes(prod[3]);
-    sj_corner<3>(qx, qy, qz, jac[4], prod[4], degenerate);
+    sj_corner<3>(qx, qy, qz, jac[4], prod[4], shortest);
     Sqrt::lanes(prod[4]);
-    sj_corner<4>(qx, qy, qz, jac[5], prod[5], degenerate);
+    sj_corner<4>(qx, qy, qz, jac[5], prod[5], shortest);
     Sqrt::lanes(prod[5]);
-    sj_corner<5>(qx, qy, qz, jac[6], prod[6], degenerate);
+    sj_corner<5>(qx, qy, qz, jac[6], prod[6], shortest);
     Sqrt::lanes(prod[6]);
-    sj_corner<6>(qx, qy, qz, jac[7], prod[7], degenerate);
+    sj_corner<6>(qx, qy, qz, jac[7], prod[7], shortest);
     Sqrt::lanes(prod[7]);
-    sj_corner<7>(qx, qy, qz, jac[8], prod[8], degenerate);
+    sj_corner<7>(qx, qy, qz, jac[8], prod[8], shortest);
     Sqrt::lanes(prod[8]);
     alignas(64) double res[kLanes];
     for (int l = 0; l < kLanes; ++l) {
@@ -202,7 +204,7 @@ template <class Sqrt>
       }
       // Verdict's clamp (m is never NaN: it only takes values that compare below it).
       const double clamped = m > 0 ? (m < kDblMax ? m : kDblMax) : (m > -kDblMax ? m : -kDblMax);
-      res[l] = degenerate[l] != 0 ? kDblMax : clamped;
+      res[l] = shortest[l] <= kVerdictDblMin ? kDblMax : clamped;
     }
     for (std::size_t l = 0; l < n; ++l) out[h0 + l] = res[l];
   }

@@ -60,7 +60,8 @@ void prefilter_axis(Volume& v, int axis) {
       const std::size_t base = static_cast<std::size_t>(p) * stride[a1] + static_cast<std::size_t>(q) * stride[a2];
       for (Index i = 0; i < n; ++i) line[i] = v.values[base + static_cast<std::size_t>(i) * stride[axis]];
       bspline_prefilter(line.data(), line.size());
-      for (Index i = 0; i < n; ++i) v.values[base + static_cast<std::size_t>(i) * stride[axis]] = static_cast<float>(line[i]);
+      for (Index i = 0; i < n; ++i)
+        v.values[base + static_cast<std::size_t>(i) * stride[axis]] = static_cast<float>(line[i]);
     }
   });
 }

@@ -53,8 +53,8 @@ FileSource::FileSource(const fs::path& file, std::size_t offset) : file_(file), 
   fp_.reset(std::fopen(file.c_str(), "rb"));
   if (!fp_) throw Error(fmt::format("{}: cannot open: {}", file.string(), std::strerror(errno)));
   if (offset > size_)
-    throw Error(fmt::format("{}: data should start at byte {}, but the file has only {} bytes", file.string(), offset,
-                            size_));
+    throw Error(
+        fmt::format("{}: data should start at byte {}, but the file has only {} bytes", file.string(), offset, size_));
   if (offset > 0 && fseeko(fp_.get(), static_cast<off_t>(offset), SEEK_SET) != 0)
     throw Error(fmt::format("{}: cannot seek to byte {}: {}", file.string(), offset, std::strerror(errno)));
   pos_ = offset;
@@ -76,7 +76,10 @@ std::size_t MemorySource::read(unsigned char* out, std::size_t n) {
 }
 
 InflateSource::InflateSource(ByteSource& input, fs::path file, std::string what)
-    : input_(input), file_(std::move(file)), what_(std::move(what)), zs_(std::make_unique<z_stream>()),
+    : input_(input),
+      file_(std::move(file)),
+      what_(std::move(what)),
+      zs_(std::make_unique<z_stream>()),
       buffer_(std::make_unique<unsigned char[]>(kInflateBuffer)) {
   // 15 + 32: the largest window, with the zlib or gzip wrapper detected automatically.
   if (inflateInit2(zs_.get(), 15 + 32) != Z_OK) fail("zlib initialisation failed");

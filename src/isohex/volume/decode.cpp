@@ -1,6 +1,7 @@
 #include "isohex/volume/decode.hpp"
 
 #include "isohex/error.hpp"
+#include "isohex/io/format_support.hpp"
 #include "isohex/io/text_scanner.hpp"
 
 #include <fmt/format.h>
@@ -46,7 +47,8 @@ void decode_typed(ByteSource& source, bool big_endian, Volume& volume, const fs:
            fmt::format("ends after {} of the {} bytes that {} values of type {} need (truncated, or the header's "
                        "sizes or type are wrong)",
                        first * sizeof(T) + got, n * sizeof(T), n, scalar_type_name(volume.source_type)));
-    for (std::size_t i = 0; i < count; ++i) out[first + i] = static_cast<float>(load<T>(buf.data() + i * sizeof(T), swap));
+    for (std::size_t i = 0; i < count; ++i)
+      out[first + i] = static_cast<float>(load<T>(buf.data() + i * sizeof(T), swap));
   }
 }
 
@@ -65,11 +67,14 @@ std::size_t check_dims(const fs::path& file, std::string_view field, const std::
     if (dims[a] <= 0)
       fail(file, field, fmt::format("the {} size is {}; every size must be positive", kAxis[a], dims[a]));
     if (dims[a] > std::numeric_limits<Index>::max())
-      fail(file, field, fmt::format("the {} size {} exceeds isohex's limit of {} points per axis", kAxis[a], dims[a],
-                                    std::numeric_limits<Index>::max()));
+      fail(file, field,
+           fmt::format("the {} size {} exceeds isohex's limit of {} points per axis", kAxis[a], dims[a],
+                       std::numeric_limits<Index>::max()));
     const auto d = static_cast<std::size_t>(dims[a]);
-    if (count > std::numeric_limits<std::size_t>::max() / d) overflow = true;
-    else count *= d;
+    if (count > std::numeric_limits<std::size_t>::max() / d)
+      overflow = true;
+    else
+      count *= d;
   }
   const std::string shape = fmt::format("{} x {} x {}", dims[0], dims[1], dims[2]);
   if (overflow || count > std::numeric_limits<std::size_t>::max() / sizeof(double))
@@ -162,14 +167,22 @@ void place_grid(Volume& volume, const Eigen::Matrix3d& axes, const Vec3& origin,
 void read_samples(ByteSource& source, ScalarType type, bool big_endian, Volume& volume, const fs::path& file,
                   std::string_view what) {
   switch (type) {
-    case ScalarType::u8: return decode_typed<std::uint8_t>(source, big_endian, volume, file, what);
-    case ScalarType::i8: return decode_typed<std::int8_t>(source, big_endian, volume, file, what);
-    case ScalarType::u16: return decode_typed<std::uint16_t>(source, big_endian, volume, file, what);
-    case ScalarType::i16: return decode_typed<std::int16_t>(source, big_endian, volume, file, what);
-    case ScalarType::u32: return decode_typed<std::uint32_t>(source, big_endian, volume, file, what);
-    case ScalarType::i32: return decode_typed<std::int32_t>(source, big_endian, volume, file, what);
-    case ScalarType::f32: return decode_typed<float>(source, big_endian, volume, file, what);
-    case ScalarType::f64: return decode_typed<double>(source, big_endian, volume, file, what);
+    case ScalarType::u8:
+      return decode_typed<std::uint8_t>(source, big_endian, volume, file, what);
+    case ScalarType::i8:
+      return decode_typed<std::int8_t>(source, big_endian, volume, file, what);
+    case ScalarType::u16:
+      return decode_typed<std::uint16_t>(source, big_endian, volume, file, what);
+    case ScalarType::i16:
+      return decode_typed<std::int16_t>(source, big_endian, volume, file, what);
+    case ScalarType::u32:
+      return decode_typed<std::uint32_t>(source, big_endian, volume, file, what);
+    case ScalarType::i32:
+      return decode_typed<std::int32_t>(source, big_endian, volume, file, what);
+    case ScalarType::f32:
+      return decode_typed<float>(source, big_endian, volume, file, what);
+    case ScalarType::f64:
+      return decode_typed<double>(source, big_endian, volume, file, what);
   }
 }
 
@@ -181,10 +194,10 @@ void read_ascii_samples(io::TextScanner& scanner, Volume& volume, std::string_vi
     if (tok.empty()) scanner.fail(fmt::format("{} ends after {} of its {} values", what, i, n));
     double v = 0;
     if (!io::parse_double(tok, v))
-      scanner.fail(fmt::format("{}: value {} '{}' is not a finite number", what, i, tok.substr(0, 40)));
+      scanner.fail(fmt::format("{}: value {} '{}' is not a finite number", what, i, io::printable(tok)));
     const auto f = static_cast<float>(v);
     if (integer && !scalar_type_holds(volume.source_type, f))
-      scanner.fail(fmt::format("{}: value {} '{}' is not a {} value", what, i, tok.substr(0, 40),
+      scanner.fail(fmt::format("{}: value {} '{}' is not a {} value", what, i, io::printable(tok),
                                scalar_type_name(volume.source_type)));
     volume.values[i] = f;
   }

@@ -46,9 +46,7 @@ std::optional<Inside> inside_from_name(std::string_view name) {
   return std::nullopt;
 }
 
-Vec3 grid_coordinates(const Volume& volume, const Vec3& p) {
-  return (p - volume.origin).cwiseQuotient(volume.spacing);
-}
+Vec3 grid_coordinates(const Volume& volume, const Vec3& p) { return (p - volume.origin).cwiseQuotient(volume.spacing); }
 
 double sample(const Volume& volume, const Vec3& p, Vec3& grad) {
   const Vec3 t = grid_coordinates(volume, p);

@@ -32,7 +32,9 @@ inline double inside_level(double value, double isovalue, Inside inside) {
 }
 
 /// True when `value` is strictly on the inside of `isovalue`.
-inline bool is_inside(double value, double isovalue, Inside inside) { return inside_level(value, isovalue, inside) > 0; }
+inline bool is_inside(double value, double isovalue, Inside inside) {
+  return inside_level(value, isovalue, inside) > 0;
+}
 
 /// The continuous grid coordinates (i, j, k) of world point `p`: grid point (i, j, k) of
 /// `volume` sits at `p` when they are integers.

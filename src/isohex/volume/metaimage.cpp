@@ -3,6 +3,7 @@
 // (CompressedData), either byte order; ASCII data (BinaryData = False).
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
+#include "isohex/io/format_support.hpp"
 #include "isohex/io/text_scanner.hpp"
 #include "isohex/volume/decode.hpp"
 #include "isohex/volume/formats.hpp"
@@ -25,16 +26,16 @@ struct MetaHeader {
   Eigen::Matrix3d directions = Eigen::Matrix3d::Identity();  // row i: direction of axis i
   bool msb = false, binary = true, compressed = false;
   std::int64_t header_size = 0;
-  std::string data_file;             // "LOCAL" or a path
-  std::size_t data_offset = 0;       // LOCAL: where the data starts
+  std::string data_file;        // "LOCAL" or a path
+  std::size_t data_offset = 0;  // LOCAL: where the data starts
 };
 
 std::optional<ScalarType> meta_type(std::string_view name) {
   // MetaIO's MET_LONG and MET_ULONG are 4 bytes, whatever the platform's long.
   static constexpr std::pair<std::string_view, ScalarType> kTypes[] = {
-      {"MET_UCHAR", ScalarType::u8},  {"MET_CHAR", ScalarType::i8},   {"MET_USHORT", ScalarType::u16},
-      {"MET_SHORT", ScalarType::i16}, {"MET_UINT", ScalarType::u32},  {"MET_INT", ScalarType::i32},
-      {"MET_ULONG", ScalarType::u32}, {"MET_LONG", ScalarType::i32},  {"MET_FLOAT", ScalarType::f32},
+      {"MET_UCHAR", ScalarType::u8},  {"MET_CHAR", ScalarType::i8},  {"MET_USHORT", ScalarType::u16},
+      {"MET_SHORT", ScalarType::i16}, {"MET_UINT", ScalarType::u32}, {"MET_INT", ScalarType::i32},
+      {"MET_ULONG", ScalarType::u32}, {"MET_LONG", ScalarType::i32}, {"MET_FLOAT", ScalarType::f32},
       {"MET_DOUBLE", ScalarType::f64}};
   for (const auto& [n, t] : kTypes)
     if (lowercase(n) == lowercase(name)) return t;
@@ -57,7 +58,7 @@ class HeaderParser {
       if (raw.empty()) continue;
       const std::size_t eq = raw.find('=');
       if (eq == std::string_view::npos)
-        fail(file_, fmt::format("line {}", line), fmt::format("'{}' is not a 'Key = Value' line", raw.substr(0, 60)));
+        fail(file_, fmt::format("line {}", line), fmt::format("'{}' is not a 'Key = Value' line", io::printable(raw)));
       const std::string key = lowercase(trim(raw.substr(0, eq)));
       const std::string_view value = trim(raw.substr(eq + 1));
       ended = key == "elementdatafile";
@@ -74,7 +75,7 @@ class HeaderParser {
  private:
   Vec3 vector(std::string_view key, std::string_view value) const {
     double v[3];
-    if (!parse_numbers(value, v, 3)) fail(file_, key, fmt::format("'{}' is not 3 numbers", value.substr(0, 60)));
+    if (!parse_numbers(value, v, 3)) fail(file_, key, fmt::format("'{}' is not 3 numbers", io::printable(value)));
     return {v[0], v[1], v[2]};
   }
 
@@ -82,33 +83,35 @@ class HeaderParser {
     const std::string v = lowercase(value);
     if (v == "true" || v == "1") return true;
     if (v == "false" || v == "0") return false;
-    fail(file_, key, fmt::format("'{}' is neither True nor False", value.substr(0, 40)));
+    fail(file_, key, fmt::format("'{}' is neither True nor False", io::printable(value)));
   }
 
   void field(const std::string& key, std::string_view value) {
     if (key == "objecttype") {
-      if (lowercase(value) != "image") fail(file_, "ObjectType", fmt::format("'{}' is not Image", value.substr(0, 40)));
+      if (lowercase(value) != "image")
+        fail(file_, "ObjectType", fmt::format("'{}' is not Image", io::printable(value)));
     } else if (key == "ndims") {
       std::int64_t n = 0;
-      if (!io::parse_int(value, n)) fail(file_, "NDims", fmt::format("'{}' is not an integer", value.substr(0, 40)));
+      if (!io::parse_int(value, n)) fail(file_, "NDims", fmt::format("'{}' is not an integer", io::printable(value)));
       if (n != 3) fail(file_, "NDims", fmt::format("isohex reads 3-D volumes; this one has NDims {}", n));
       ndims_seen_ = true;
     } else if (key == "dimsize") {
       std::array<std::int64_t, 3> d{};
       double v[3];
-      if (!parse_numbers(value, v, 3)) fail(file_, "DimSize", fmt::format("'{}' is not 3 sizes", value.substr(0, 60)));
+      if (!parse_numbers(value, v, 3)) fail(file_, "DimSize", fmt::format("'{}' is not 3 sizes", io::printable(value)));
       for (int a = 0; a < 3; ++a) {
         if (!(v[a] >= -9e18 && v[a] <= 9e18) || v[a] != static_cast<double>(static_cast<std::int64_t>(v[a])))
-          fail(file_, "DimSize", fmt::format("'{}' is not 3 integers", value.substr(0, 60)));
+          fail(file_, "DimSize", fmt::format("'{}' is not 3 integers", io::printable(value)));
         d[a] = static_cast<std::int64_t>(v[a]);
       }
       h_.dims = d;
     } else if (key == "elementtype") {
       h_.type = meta_type(value);
       if (!h_.type)
-        fail(file_, "ElementType", fmt::format("unsupported type '{}' (isohex reads MET_UCHAR, MET_CHAR, MET_USHORT, "
-                                               "MET_SHORT, MET_UINT, MET_INT, MET_FLOAT, MET_DOUBLE)",
-                                               value.substr(0, 40)));
+        fail(file_, "ElementType",
+             fmt::format("unsupported type '{}' (isohex reads MET_UCHAR, MET_CHAR, MET_USHORT, "
+                         "MET_SHORT, MET_UINT, MET_INT, MET_FLOAT, MET_DOUBLE)",
+                         io::printable(value)));
     } else if (key == "elementspacing") {
       h_.spacing = vector("ElementSpacing", value);
     } else if (key == "elementsize") {
@@ -127,9 +130,11 @@ class HeaderParser {
       h_.compressed = boolean("CompressedData", value);
     } else if (key == "headersize") {
       if (!io::parse_int(value, h_.header_size) || h_.header_size < -1)
-        fail(file_, "HeaderSize", fmt::format("'{}' is not an integer >= -1", value.substr(0, 40)));
+        fail(file_, "HeaderSize", fmt::format("'{}' is not an integer >= -1", io::printable(value)));
     } else if (key == "elementnumberofchannels") {
-      if (value != "1") fail(file_, "ElementNumberOfChannels", fmt::format("is {}; isohex reads scalar volumes (1)", value));
+      if (value != "1")
+        fail(file_, "ElementNumberOfChannels",
+             fmt::format("is {}; isohex reads scalar volumes (1)", io::printable(value)));
     } else if (key == "elementdatafile") {
       if (value.empty()) fail(file_, "ElementDataFile", "is empty");
       if (lowercase(value).starts_with("list") || value.find('%') != std::string_view::npos)
@@ -148,8 +153,7 @@ class HeaderParser {
 }  // namespace
 
 Volume read_metaimage(const fs::path& file, const VolumeReadOptions& options) {
-  const MetaHeader h =
-      parse_header(file, [&](std::string_view text, bool) { return HeaderParser(file, text).run(); });
+  const MetaHeader h = parse_header(file, [&](std::string_view text, bool) { return HeaderParser(file, text).run(); });
   const std::size_t count = check_dims(file, "DimSize", *h.dims, options);
   const Vec3 spacing = h.spacing ? *h.spacing : h.size.value_or(Vec3::Ones());
   check_vector(file, h.spacing ? "ElementSpacing" : "ElementSize", spacing, true);
@@ -173,10 +177,11 @@ Volume read_metaimage(const fs::path& file, const VolumeReadOptions& options) {
   if (h.binary && !h.compressed) {
     const std::size_t size = size_of_file(data);
     if (size < offset || size - offset < bytes)
-      fail(data, "data", fmt::format("has {} bytes of data after byte {}, but DimSize {} x {} x {} of {} needs {} "
-                                     "(truncated, or the header lies)",
-                                     size > offset ? size - offset : 0, offset, (*h.dims)[0], (*h.dims)[1],
-                                     (*h.dims)[2], scalar_type_name(*h.type), bytes));
+      fail(data, "data",
+           fmt::format("has {} bytes of data after byte {}, but DimSize {} x {} x {} of {} needs {} "
+                       "(truncated, or the header lies)",
+                       size > offset ? size - offset : 0, offset, (*h.dims)[0], (*h.dims)[1], (*h.dims)[2],
+                       scalar_type_name(*h.type), bytes));
   }
 
   Volume v = allocate_volume(file, "DimSize", *h.dims, *h.type, options);

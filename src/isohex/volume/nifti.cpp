@@ -46,35 +46,54 @@ class Header {
 
 // Field offsets of the NIfTI-1 header.
 constexpr std::size_t kDim = 40, kDatatype = 70, kBitpix = 72, kPixdim = 76, kVoxOffset = 108, kSclSlope = 112,
-                      kSclInter = 116, kQformCode = 252, kSformCode = 254, kQuatern = 256, kQoffset = 268,
-                      kSrow = 280, kMagic = 344;
+                      kSclInter = 116, kQformCode = 252, kSformCode = 254, kQuatern = 256, kQoffset = 268, kSrow = 280,
+                      kMagic = 344;
 
 std::string_view datatype_name(int code) {
   switch (code) {
-    case 1: return "binary";
-    case 32: return "complex64";
-    case 128: return "rgb24";
-    case 1024: return "int64";
-    case 1280: return "uint64";
-    case 1536: return "float128";
-    case 1792: return "complex128";
-    case 2048: return "complex256";
-    case 2304: return "rgba32";
-    default: return "unknown";
+    case 1:
+      return "binary";
+    case 32:
+      return "complex64";
+    case 128:
+      return "rgb24";
+    case 1024:
+      return "int64";
+    case 1280:
+      return "uint64";
+    case 1536:
+      return "float128";
+    case 1792:
+      return "complex128";
+    case 2048:
+      return "complex256";
+    case 2304:
+      return "rgba32";
+    default:
+      return "unknown";
   }
 }
 
 std::optional<ScalarType> datatype(int code) {
   switch (code) {
-    case 2: return ScalarType::u8;
-    case 4: return ScalarType::i16;
-    case 8: return ScalarType::i32;
-    case 16: return ScalarType::f32;
-    case 64: return ScalarType::f64;
-    case 256: return ScalarType::i8;
-    case 512: return ScalarType::u16;
-    case 768: return ScalarType::u32;
-    default: return std::nullopt;
+    case 2:
+      return ScalarType::u8;
+    case 4:
+      return ScalarType::i16;
+    case 8:
+      return ScalarType::i32;
+    case 16:
+      return ScalarType::f32;
+    case 64:
+      return ScalarType::f64;
+    case 256:
+      return ScalarType::i8;
+    case 512:
+      return ScalarType::u16;
+    case 768:
+      return ScalarType::u32;
+    default:
+      return std::nullopt;
   }
 }
 
@@ -92,7 +111,7 @@ void transform(const Header& h, const Vec3& pixdim, Eigen::Matrix3d& axes, Vec3&
     const double a = std::sqrt(std::max(0.0, 1.0 - (b * b + c * c + d * d)));
     Eigen::Matrix3d rot;
     rot << a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c),  //
-        2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b),      //
+        2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b),     //
         2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b;
     const double qfac = h.f32(kPixdim) < 0 ? -1.0 : 1.0;
     axes = rot * Vec3(pixdim[0], pixdim[1], qfac * pixdim[2]).asDiagonal();
@@ -126,8 +145,8 @@ Volume read_nifti(const fs::path& file, const VolumeReadOptions& options) {
     if (swapped_size != 348) {
       if (native_size == 540 || swapped_size == 540)
         fail(file, "sizeof_hdr", "540: a NIfTI-2 file; isohex reads NIfTI-1");
-      fail(file, "sizeof_hdr", fmt::format("is {} (or {} byte-swapped), not 348: not a NIfTI-1 file", native_size,
-                                           swapped_size));
+      fail(file, "sizeof_hdr",
+           fmt::format("is {} (or {} byte-swapped), not 348: not a NIfTI-1 file", native_size, swapped_size));
     }
   }
   const unsigned char* magic = h.bytes() + kMagic;
@@ -145,9 +164,11 @@ Volume read_nifti(const fs::path& file, const VolumeReadOptions& options) {
            fmt::format("is {}: a {}-D series; isohex reads one 3-D volume", h.i16(kDim + 2 * a), ndim));
   const int code = h.i16(kDatatype);
   const auto type = datatype(code);
-  if (!type) fail(file, "datatype", fmt::format("{} ({}) is not supported (isohex reads 8- to 32-bit integers, float32 "
-                                                "and float64)",
-                                                code, datatype_name(code)));
+  if (!type)
+    fail(file, "datatype",
+         fmt::format("{} ({}) is not supported (isohex reads 8- to 32-bit integers, float32 "
+                     "and float64)",
+                     code, datatype_name(code)));
   const int bitpix = h.i16(kBitpix);
   if (static_cast<std::size_t>(bitpix) != 8 * scalar_type_size(*type))
     fail(file, "bitpix", fmt::format("is {}, but datatype {} has {} bits", bitpix, code, 8 * scalar_type_size(*type)));
@@ -187,8 +208,9 @@ Volume read_nifti(const fs::path& file, const VolumeReadOptions& options) {
   Eigen::Matrix3d axes;
   Vec3 origin;
   transform(h, pixdim, axes, origin);
-  const char* field = h.i16(kSformCode) > 0 ? "srow_x/y/z (sform)"
-                      : h.i16(kQformCode) > 0 ? "quatern/qoffset (qform)" : "pixdim";
+  const char* field = h.i16(kSformCode) > 0   ? "srow_x/y/z (sform)"
+                      : h.i16(kQformCode) > 0 ? "quatern/qoffset (qform)"
+                                              : "pixdim";
   place_grid(v, axes, origin, file, field);
   return v;
 }

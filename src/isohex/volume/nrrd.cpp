@@ -4,6 +4,7 @@
 // endian, with space directions and origin so that Slicer, ITK and VTK place it alike.
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
+#include "isohex/io/format_support.hpp"
 #include "isohex/io/text_scanner.hpp"
 #include "isohex/volume/decode.hpp"
 #include "isohex/volume/formats.hpp"
@@ -33,35 +34,60 @@ struct NrrdHeader {
   bool has_encoding = false;
   std::vector<fs::path> data_files;  // empty: the data follows the header
   std::int64_t line_skip = 0, byte_skip = 0;
-  std::size_t data_offset = 0;       // attached data: where it starts in the file
+  std::size_t data_offset = 0;  // attached data: where it starts in the file
 };
 
 /// NRRD's type names (all spellings teem accepts for the 8 supported types).
 const std::map<std::string, ScalarType>& type_names() {
-  static const std::map<std::string, ScalarType> names = {
-      {"uchar", ScalarType::u8},          {"unsigned char", ScalarType::u8},   {"uint8", ScalarType::u8},
-      {"uint8_t", ScalarType::u8},        {"signed char", ScalarType::i8},     {"int8", ScalarType::i8},
-      {"int8_t", ScalarType::i8},         {"ushort", ScalarType::u16},         {"unsigned short", ScalarType::u16},
-      {"unsigned short int", ScalarType::u16}, {"uint16", ScalarType::u16},    {"uint16_t", ScalarType::u16},
-      {"short", ScalarType::i16},         {"short int", ScalarType::i16},      {"signed short", ScalarType::i16},
-      {"signed short int", ScalarType::i16}, {"int16", ScalarType::i16},       {"int16_t", ScalarType::i16},
-      {"uint", ScalarType::u32},          {"unsigned int", ScalarType::u32},   {"uint32", ScalarType::u32},
-      {"uint32_t", ScalarType::u32},      {"int", ScalarType::i32},            {"signed int", ScalarType::i32},
-      {"int32", ScalarType::i32},         {"int32_t", ScalarType::i32},        {"float", ScalarType::f32},
-      {"double", ScalarType::f64}};
+  static const std::map<std::string, ScalarType> names = {{"uchar", ScalarType::u8},
+                                                          {"unsigned char", ScalarType::u8},
+                                                          {"uint8", ScalarType::u8},
+                                                          {"uint8_t", ScalarType::u8},
+                                                          {"signed char", ScalarType::i8},
+                                                          {"int8", ScalarType::i8},
+                                                          {"int8_t", ScalarType::i8},
+                                                          {"ushort", ScalarType::u16},
+                                                          {"unsigned short", ScalarType::u16},
+                                                          {"unsigned short int", ScalarType::u16},
+                                                          {"uint16", ScalarType::u16},
+                                                          {"uint16_t", ScalarType::u16},
+                                                          {"short", ScalarType::i16},
+                                                          {"short int", ScalarType::i16},
+                                                          {"signed short", ScalarType::i16},
+                                                          {"signed short int", ScalarType::i16},
+                                                          {"int16", ScalarType::i16},
+                                                          {"int16_t", ScalarType::i16},
+                                                          {"uint", ScalarType::u32},
+                                                          {"unsigned int", ScalarType::u32},
+                                                          {"uint32", ScalarType::u32},
+                                                          {"uint32_t", ScalarType::u32},
+                                                          {"int", ScalarType::i32},
+                                                          {"signed int", ScalarType::i32},
+                                                          {"int32", ScalarType::i32},
+                                                          {"int32_t", ScalarType::i32},
+                                                          {"float", ScalarType::f32},
+                                                          {"double", ScalarType::f64}};
   return names;
 }
 
 const char* nrrd_type_name(ScalarType t) {
   switch (t) {
-    case ScalarType::u8: return "uint8";
-    case ScalarType::i8: return "int8";
-    case ScalarType::u16: return "uint16";
-    case ScalarType::i16: return "int16";
-    case ScalarType::u32: return "uint32";
-    case ScalarType::i32: return "int32";
-    case ScalarType::f32: return "float";
-    case ScalarType::f64: break;
+    case ScalarType::u8:
+      return "uint8";
+    case ScalarType::i8:
+      return "int8";
+    case ScalarType::u16:
+      return "uint16";
+    case ScalarType::i16:
+      return "int16";
+    case ScalarType::u32:
+      return "uint32";
+    case ScalarType::i32:
+      return "int32";
+    case ScalarType::f32:
+      return "float";
+    case ScalarType::f64:
+      break;
   }
   return "double";
 }
@@ -104,7 +130,8 @@ std::optional<std::string> format_series_name(std::string_view pattern, std::int
     bool zero = false;
     int width = 0;
     if (i < pattern.size() && pattern[i] == '0') zero = true, ++i;
-    while (i < pattern.size() && pattern[i] >= '0' && pattern[i] <= '9' && width < 100) width = width * 10 + (pattern[i++] - '0');
+    while (i < pattern.size() && pattern[i] >= '0' && pattern[i] <= '9' && width < 100)
+      width = width * 10 + (pattern[i++] - '0');
     if (i >= pattern.size() || pattern[i] != 'd' || converted) return std::nullopt;
     std::string digits = std::to_string(n < 0 ? -n : n);
     const std::size_t sign = n < 0 ? 1 : 0;
@@ -144,8 +171,7 @@ class HeaderParser {
     }
     if (!ended && !whole_) fail_line(line, "header does not end within the first megabyte");
     h_.data_offset = pos;
-    if (h_.data_files.empty() && (list_ || data_file_seen_))
-      fail_field("data file", "names no data files");
+    if (h_.data_files.empty() && (list_ || data_file_seen_)) fail_field("data file", "names no data files");
     if (!ended && h_.data_files.empty()) fail_line(line, "the header has no data file and no blank line before data");
     check();
     return h_;
@@ -176,7 +202,8 @@ class HeaderParser {
 
   void field(std::string_view raw, std::size_t line) {
     const std::size_t colon = raw.find(':');
-    if (colon == std::string_view::npos) fail_line(line, fmt::format("'{}' is not a 'field: value' line", raw.substr(0, 60)));
+    if (colon == std::string_view::npos)
+      fail_line(line, fmt::format("'{}' is not a 'field: value' line", io::printable(raw)));
     if (colon + 1 < raw.size() && raw[colon + 1] == '=') return;  // key:=value metadata
     const std::string name = lowercase(trim(raw.substr(0, colon)));
     const std::string_view value = trim(raw.substr(colon + 1));
@@ -186,25 +213,28 @@ class HeaderParser {
       if (it == type_names().end())
         fail_field(name, fmt::format("unsupported type '{}' (isohex reads the 8- to 32-bit integer types, float and "
                                      "double)",
-                                     value.substr(0, 40)));
+                                     io::printable(value)));
       h_.type = it->second;
     } else if (name == "dimension") {
       std::int64_t d = 0;
-      if (!io::parse_int(value, d)) fail_field(name, fmt::format("'{}' is not an integer", value.substr(0, 40)));
+      if (!io::parse_int(value, d)) fail_field(name, fmt::format("'{}' is not an integer", io::printable(value)));
       if (d != 3) fail_field(name, fmt::format("isohex reads 3-D volumes; this one has dimension {}", d));
       dimension_seen_ = true;
     } else if (name == "sizes") {
       std::array<std::int64_t, 3> s{};
       if (tokens.size() != 3) fail_field(name, fmt::format("needs 3 sizes, found {}", tokens.size()));
       for (int a = 0; a < 3; ++a)
-        if (!io::parse_int(tokens[a], s[a])) fail_field(name, fmt::format("'{}' is not an integer", tokens[a].substr(0, 40)));
+        if (!io::parse_int(tokens[a], s[a]))
+          fail_field(name, fmt::format("'{}' is not an integer", io::printable(tokens[a])));
       h_.sizes = s;
     } else if (name == "spacings") {
       if (tokens.size() != 3) fail_field(name, fmt::format("needs 3 spacings, found {}", tokens.size()));
       Vec3 s;
       for (int a = 0; a < 3; ++a) {
-        if (lowercase(tokens[a]) == "nan") s[a] = 1;  // NRRD's "unknown": unit spacing
-        else if (!io::parse_double(tokens[a], s[a])) fail_field(name, fmt::format("'{}' is not a number", tokens[a].substr(0, 40)));
+        if (lowercase(tokens[a]) == "nan")
+          s[a] = 1;  // NRRD's "unknown": unit spacing
+        else if (!io::parse_double(tokens[a], s[a]))
+          fail_field(name, fmt::format("'{}' is not a number", io::printable(tokens[a])));
       }
       h_.spacings = s;
     } else if (name == "space directions") {
@@ -212,35 +242,42 @@ class HeaderParser {
       Eigen::Matrix3d m;
       for (int a = 0; a < 3; ++a) {
         const auto v = parse_vector(tokens[a]);
-        if (!v) fail_field(name, fmt::format("'{}' is not a 3-D vector (x,y,z); every axis must be spatial",
-                                             tokens[a].substr(0, 60)));
+        if (!v)
+          fail_field(name, fmt::format("'{}' is not a 3-D vector (x,y,z); every axis must be spatial",
+                                       io::printable(tokens[a])));
         m.col(a) = *v;
       }
       h_.directions = m;
     } else if (name == "space origin") {
       const auto v = parse_vector(value);
-      if (!v) fail_field(name, fmt::format("'{}' is not a 3-D vector (x,y,z)", value.substr(0, 60)));
+      if (!v) fail_field(name, fmt::format("'{}' is not a 3-D vector (x,y,z)", io::printable(value)));
       h_.origin = v;
     } else if (name == "axis mins") {
       double v[3];
       if (parse_numbers(value, v, 3)) h_.axis_mins = Vec3(v[0], v[1], v[2]);
     } else if (name == "endian") {
       const std::string e = lowercase(value);
-      if (e != "little" && e != "big") fail_field(name, fmt::format("'{}' is neither little nor big", value.substr(0, 40)));
+      if (e != "little" && e != "big")
+        fail_field(name, fmt::format("'{}' is neither little nor big", io::printable(value)));
       h_.big_endian = e == "big";
     } else if (name == "encoding") {
       const std::string e = lowercase(value);
-      if (e == "raw") h_.encoding = Encoding::raw;
-      else if (e == "gzip" || e == "gz") h_.encoding = Encoding::gzip;
-      else if (e == "ascii" || e == "text" || e == "txt") h_.encoding = Encoding::ascii;
-      else fail_field(name, fmt::format("unsupported encoding '{}' (isohex reads raw, gzip and ascii)", value.substr(0, 40)));
+      if (e == "raw")
+        h_.encoding = Encoding::raw;
+      else if (e == "gzip" || e == "gz")
+        h_.encoding = Encoding::gzip;
+      else if (e == "ascii" || e == "text" || e == "txt")
+        h_.encoding = Encoding::ascii;
+      else
+        fail_field(name,
+                   fmt::format("unsupported encoding '{}' (isohex reads raw, gzip and ascii)", io::printable(value)));
       h_.has_encoding = true;
     } else if (name == "line skip" || name == "lineskip") {
       if (!io::parse_int(value, h_.line_skip) || h_.line_skip < 0)
-        fail_field(name, fmt::format("'{}' is not a non-negative integer", value.substr(0, 40)));
+        fail_field(name, fmt::format("'{}' is not a non-negative integer", io::printable(value)));
     } else if (name == "byte skip" || name == "byteskip") {
       if (!io::parse_int(value, h_.byte_skip) || h_.byte_skip < -1)
-        fail_field(name, fmt::format("'{}' is not an integer >= -1", value.substr(0, 40)));
+        fail_field(name, fmt::format("'{}' is not an integer >= -1", io::printable(value)));
     } else if (name == "data file" || name == "datafile") {
       data_file(value, tokens);
     } else if (name == "block size" || name == "blocksize") {
@@ -257,13 +294,15 @@ class HeaderParser {
     }
     if (tokens.size() >= 4 && tokens[0].find('%') != std::string_view::npos) {
       std::int64_t lo = 0, hi = 0, step = 0;
-      if (!io::parse_int(tokens[1], lo) || !io::parse_int(tokens[2], hi) || !io::parse_int(tokens[3], step) || step == 0)
+      if (!io::parse_int(tokens[1], lo) || !io::parse_int(tokens[2], hi) || !io::parse_int(tokens[3], step) ||
+          step == 0)
         fail_field("data file", "a numbered series needs integer min, max and a non-zero step");
       if ((hi - lo) / step < 0 || (hi - lo) / step > 1000000)
         fail_field("data file", fmt::format("the series {} to {} by {} is empty or too long", lo, hi, step));
       for (std::int64_t n = lo; step > 0 ? n <= hi : n >= hi; n += step) {
         const auto name = format_series_name(tokens[0], n);
-        if (!name) fail_field("data file", fmt::format("'{}' is not a name pattern with one %d", tokens[0].substr(0, 60)));
+        if (!name)
+          fail_field("data file", fmt::format("'{}' is not a name pattern with one %d", io::printable(tokens[0])));
         h_.data_files.push_back(resolve(*name));
       }
       return;
@@ -292,9 +331,9 @@ class HeaderParser {
 /// Skips `lines` newline-terminated lines of `src`.
 void skip_lines(ByteSource& src, std::int64_t lines, const fs::path& file) {
   unsigned char c;
-  for (std::int64_t i = 0; i < lines; ++i)
-    do {
-      if (src.read(&c, 1) != 1) fail(file, "field 'line skip'", fmt::format("the data file has fewer than {} lines", lines));
+  for (std::int64_t i = 0; i < lines; ++i) do {
+      if (src.read(&c, 1) != 1)
+        fail(file, "field 'line skip'", fmt::format("the data file has fewer than {} lines", lines));
     } while (c != '\n');
 }
 
@@ -310,10 +349,11 @@ void check_data_files(const NrrdHeader& h, const fs::path& header_file, std::siz
     const std::size_t start = (h.data_files.empty() ? h.data_offset : 0) + static_cast<std::size_t>(h.byte_skip);
     const std::size_t size = size_of_file(f);
     if (size < start + per_file)
-      fail(f, "data", fmt::format("has {} bytes of data after byte {}, but sizes {} x {} x {} of type {} need {}{} "
-                                  "(truncated, or the header lies)",
-                                  size > start ? size - start : 0, start, (*h.sizes)[0], (*h.sizes)[1], (*h.sizes)[2],
-                                  nrrd_type_name(*h.type), per_file, files.size() > 1 ? " per file" : ""));
+      fail(f, "data",
+           fmt::format("has {} bytes of data after byte {}, but sizes {} x {} x {} of type {} need {}{} "
+                       "(truncated, or the header lies)",
+                       size > start ? size - start : 0, start, (*h.sizes)[0], (*h.sizes)[1], (*h.sizes)[2],
+                       nrrd_type_name(*h.type), per_file, files.size() > 1 ? " per file" : ""));
   }
 }
 
@@ -337,8 +377,8 @@ void read_binary(const NrrdHeader& h, const fs::path& header_file, Volume& v) {
         if (left_ == 0 && !open_next()) break;
         const std::size_t got = read_full(*stream_, out + done, std::min(n - done, left_));
         if (got == 0)
-          fail(files_[index_ - 1], "data", fmt::format("ends {} bytes short of the {} bytes this file should hold",
-                                                       left_, per_file_));
+          fail(files_[index_ - 1], "data",
+               fmt::format("ends {} bytes short of the {} bytes this file should hold", left_, per_file_));
         done += got;
         left_ -= got;
       }
@@ -354,8 +394,8 @@ void read_binary(const NrrdHeader& h, const fs::path& header_file, Volume& v) {
       if (h_.byte_skip == -1) {
         const std::size_t size = size_of_file(f);
         if (size < per_file_ + offset)
-          fail(f, "field 'byte skip'", fmt::format("-1 needs {} bytes of data at the end, but the file has only {}",
-                                                   per_file_, size));
+          fail(f, "field 'byte skip'",
+               fmt::format("-1 needs {} bytes of data at the end, but the file has only {}", per_file_, size));
         offset = size - per_file_;
       }
       stream_ = nullptr;

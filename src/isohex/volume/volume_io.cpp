@@ -49,7 +49,8 @@ namespace volume_detail {
 
 Volume read_raw(const fs::path& file, const RawLayout& layout, const VolumeReadOptions& options) {
   constexpr std::string_view field = "raw layout";
-  const std::size_t count = check_dims(file, "raw layout dims", {layout.dims[0], layout.dims[1], layout.dims[2]}, options);
+  const std::size_t count =
+      check_dims(file, "raw layout dims", {layout.dims[0], layout.dims[1], layout.dims[2]}, options);
   check_vector(file, "raw layout spacing", layout.spacing, true);
   check_vector(file, "raw layout origin", layout.origin, false);
   const std::size_t value_size = scalar_type_size(layout.type);
@@ -62,8 +63,8 @@ Volume read_raw(const fs::path& file, const RawLayout& layout, const VolumeReadO
                      size, layout.header_bytes, layout.dims[0], layout.dims[1], layout.dims[2],
                      scalar_type_name(layout.type),
                      fits ? fmt::format("{}", layout.header_bytes + count * value_size) : std::string("more")));
-  Volume v = allocate_volume(file, "raw layout dims", {layout.dims[0], layout.dims[1], layout.dims[2]}, layout.type,
-                             options);
+  Volume v =
+      allocate_volume(file, "raw layout dims", {layout.dims[0], layout.dims[1], layout.dims[2]}, layout.type, options);
   v.spacing = layout.spacing;
   v.origin = layout.origin;
   FileSource src(file, layout.header_bytes);
@@ -88,7 +89,8 @@ void check_volume_for_writing(const fs::path& file, const Volume& volume) {
                             volume.dims[0], volume.dims[1], volume.dims[2]));
   for (int a = 0; a < 3; ++a) {
     if (!(std::isfinite(volume.spacing[a]) && volume.spacing[a] > 0))
-      throw Error(fmt::format("{}: cannot write: spacing {} is not a positive number", file.string(), volume.spacing[a]));
+      throw Error(
+          fmt::format("{}: cannot write: spacing {} is not a positive number", file.string(), volume.spacing[a]));
     if (!std::isfinite(volume.origin[a]))
       throw Error(fmt::format("{}: cannot write: the origin is not finite", file.string()));
   }
@@ -96,14 +98,22 @@ void check_volume_for_writing(const fs::path& file, const Volume& volume) {
 
 void write_samples_le(std::ostream& out, const Volume& volume, ScalarType type) {
   switch (type) {
-    case ScalarType::u8: return write_typed<std::uint8_t>(out, volume.values);
-    case ScalarType::i8: return write_typed<std::int8_t>(out, volume.values);
-    case ScalarType::u16: return write_typed<std::uint16_t>(out, volume.values);
-    case ScalarType::i16: return write_typed<std::int16_t>(out, volume.values);
-    case ScalarType::u32: return write_typed<std::uint32_t>(out, volume.values);
-    case ScalarType::i32: return write_typed<std::int32_t>(out, volume.values);
-    case ScalarType::f32: return write_typed<float>(out, volume.values);
-    case ScalarType::f64: return write_typed<double>(out, volume.values);
+    case ScalarType::u8:
+      return write_typed<std::uint8_t>(out, volume.values);
+    case ScalarType::i8:
+      return write_typed<std::int8_t>(out, volume.values);
+    case ScalarType::u16:
+      return write_typed<std::uint16_t>(out, volume.values);
+    case ScalarType::i16:
+      return write_typed<std::int16_t>(out, volume.values);
+    case ScalarType::u32:
+      return write_typed<std::uint32_t>(out, volume.values);
+    case ScalarType::i32:
+      return write_typed<std::int32_t>(out, volume.values);
+    case ScalarType::f32:
+      return write_typed<float>(out, volume.values);
+    case ScalarType::f64:
+      return write_typed<double>(out, volume.values);
   }
 }
 
@@ -118,12 +128,14 @@ Volume read_volume(const fs::path& file, const VolumeReadOptions& options) {
   if (ends_with(name, ".nii") || ends_with(name, ".nii.gz")) return read_nifti(file, options);
   if (options.raw) return read_raw(file, *options.raw, options);
   if (ends_with(name, ".raw"))
-    throw Error(fmt::format("{}: a headerless .raw volume needs its layout: give at least its dims and type "
-                            "(--dims NX NY NZ --type u8|i8|u16|i16|u32|i32|f32|f64)",
-                            file.string()));
-  throw Error(fmt::format("{}: unknown volume format '{}' (readable: .nrrd .nhdr .mhd .mha .vtk .vti .nii "
-                          ".nii.gz, and headerless .raw with its layout)",
-                          file.string(), file.extension().string()));
+    throw Error(
+        fmt::format("{}: a headerless .raw volume needs its layout: give at least its dims and type "
+                    "(--dims NX NY NZ --type u8|i8|u16|i16|u32|i32|f32|f64)",
+                    file.string()));
+  throw Error(
+      fmt::format("{}: unknown volume format '{}' (readable: .nrrd .nhdr .mhd .mha .vtk .vti .nii "
+                  ".nii.gz, and headerless .raw with its layout)",
+                  file.string(), file.extension().string()));
 }
 
 void write_volume(const fs::path& file, const Volume& volume) {

@@ -6,6 +6,7 @@
 // in the volume's storage type.
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
+#include "isohex/io/format_support.hpp"
 #include "isohex/io/text_scanner.hpp"
 #include "isohex/io/vtk_xml_data.hpp"
 #include "isohex/io/vtk_xml_settings.hpp"
@@ -28,27 +29,43 @@ namespace xml = io::xml;
 
 ScalarType to_scalar_type(vtkxml::Scalar s) {
   switch (s) {
-    case vtkxml::Scalar::Int8: return ScalarType::i8;
-    case vtkxml::Scalar::UInt8: return ScalarType::u8;
-    case vtkxml::Scalar::Int16: return ScalarType::i16;
-    case vtkxml::Scalar::UInt16: return ScalarType::u16;
-    case vtkxml::Scalar::Int32: return ScalarType::i32;
-    case vtkxml::Scalar::UInt32: return ScalarType::u32;
-    case vtkxml::Scalar::Float32: return ScalarType::f32;
-    default: return ScalarType::f64;  // Float64, and 64-bit integers (as float values anyway)
+    case vtkxml::Scalar::Int8:
+      return ScalarType::i8;
+    case vtkxml::Scalar::UInt8:
+      return ScalarType::u8;
+    case vtkxml::Scalar::Int16:
+      return ScalarType::i16;
+    case vtkxml::Scalar::UInt16:
+      return ScalarType::u16;
+    case vtkxml::Scalar::Int32:
+      return ScalarType::i32;
+    case vtkxml::Scalar::UInt32:
+      return ScalarType::u32;
+    case vtkxml::Scalar::Float32:
+      return ScalarType::f32;
+    default:
+      return ScalarType::f64;  // Float64, and 64-bit integers (as float values anyway)
   }
 }
 
 const char* vtk_type_name(ScalarType t) {
   switch (t) {
-    case ScalarType::u8: return "UInt8";
-    case ScalarType::i8: return "Int8";
-    case ScalarType::u16: return "UInt16";
-    case ScalarType::i16: return "Int16";
-    case ScalarType::u32: return "UInt32";
-    case ScalarType::i32: return "Int32";
-    case ScalarType::f32: return "Float32";
-    case ScalarType::f64: break;
+    case ScalarType::u8:
+      return "UInt8";
+    case ScalarType::i8:
+      return "Int8";
+    case ScalarType::u16:
+      return "UInt16";
+    case ScalarType::i16:
+      return "Int16";
+    case ScalarType::u32:
+      return "UInt32";
+    case ScalarType::i32:
+      return "Int32";
+    case ScalarType::f32:
+      return "Float32";
+    case ScalarType::f64:
+      break;
   }
   return "Float64";
 }
@@ -72,7 +89,8 @@ class VtiReader {
     Eigen::Matrix3d direction;
     for (int i = 0; i < 9; ++i) direction(i / 3, i % 3) = dir[i];  // VTK lists it row by row
 
-    const std::array<std::int64_t, 3> dims = {whole[1] - whole[0] + 1, whole[3] - whole[2] + 1, whole[5] - whole[4] + 1};
+    const std::array<std::int64_t, 3> dims = {whole[1] - whole[0] + 1, whole[3] - whole[2] + 1,
+                                              whole[5] - whole[4] + 1};
     const std::string dims_field = where(*image, "WholeExtent");
     check_dims(file_, dims_field, dims, options_);
     const std::vector<const xml::Element*> pieces = doc_.children(*image, "Piece");
@@ -111,7 +129,7 @@ class VtiReader {
     if (!s) return fallback;
     Eigen::Matrix<double, N, 1> v;
     if (!parse_numbers(*s, v.data(), N))
-      fail(e.offset, fmt::format("<{}> {}=\"{}\" is not {} finite numbers", e.name, key, s->substr(0, 80), N));
+      fail(e.offset, fmt::format("<{}> {}=\"{}\" is not {} finite numbers", e.name, key, io::printable(*s), N));
     return v;
   }
 
@@ -125,7 +143,7 @@ class VtiReader {
       ok = std::abs(d[i]) <= 4e18 && d[i] == std::trunc(d[i]);
       out[i] = ok ? static_cast<std::int64_t>(d[i]) : 0;
     }
-    if (!ok) fail(e.offset, fmt::format("<{}> {}=\"{}\" is not 6 integers", e.name, key, s->substr(0, 80)));
+    if (!ok) fail(e.offset, fmt::format("<{}> {}=\"{}\" is not 6 integers", e.name, key, io::printable(*s)));
     return out;
   }
 
@@ -143,18 +161,20 @@ class VtiReader {
       if (wanted ? (name && *name == *wanted) : scalar) {
         if (!scalar)
           fail(a->offset, fmt::format("DataArray '{}' has {} components; isohex reads a scalar (1-component) array",
-                                      *wanted, *comps));
+                                      io::printable(*wanted), io::printable(*comps)));
         found = a;
         break;
       }
     }
     if (!found)
-      fail(pd->offset, wanted ? fmt::format("<PointData> names Scalars=\"{}\", but has no DataArray of that name", *wanted)
+      fail(pd->offset, wanted ? fmt::format("<PointData> names Scalars=\"{}\", but has no DataArray of that name",
+                                            io::printable(*wanted))
                               : std::string("<PointData> has no one-component DataArray"));
     const std::string* type = found->attribute("type");
     vtkxml::Scalar s;
     if (!type || !vtkxml::scalar_from_name(*type, s))
-      fail(found->offset, fmt::format("DataArray has unsupported type '{}'", type ? *type : std::string("(none)")));
+      fail(found->offset,
+           fmt::format("DataArray has unsupported type '{}'", type ? io::printable(*type) : std::string("(none)")));
     return *found;
   }
 
@@ -179,8 +199,10 @@ class VtiReader {
           for (Index i = 0; i < n[0]; ++i, ++src) {
             const std::size_t dst = v.index(at[0] + i, at[1] + j, at[2] + k);
             v.values[dst] = static_cast<float>(view[src]);
-            if (covered.empty()) ++newly;
-            else if (!covered[dst]) covered[dst] = 1, ++newly;
+            if (covered.empty())
+              ++newly;
+            else if (!covered[dst])
+              covered[dst] = 1, ++newly;
           }
     });
     return newly;

@@ -1,8 +1,8 @@
 // Legacy VTK STRUCTURED_POINTS volumes (.vtk), ASCII or BINARY (always big-endian):
 // DIMENSIONS, SPACING or its old name ASPECT_RATIO, ORIGIN, then POINT_DATA with one
 // SCALARS array, or COLOR_SCALARS with one component (what VTK writes for unsigned char
-// images: bytes in binary files, byte/255 in ASCII ones). As in VTK's reader, binary values start right after the newline that
-// ends the LOOKUP_TABLE line (or the SCALARS line when there is no lookup table).
+// images: bytes in binary files, byte/255 in ASCII ones). As in VTK's reader, binary values start right after the
+// newline that ends the LOOKUP_TABLE line (or the SCALARS line when there is no lookup table).
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/format_support.hpp"
@@ -37,15 +37,24 @@ struct LegacyHeader {
 std::optional<ScalarType> to_scalar_type(io::vtk::Scalar s) {
   using io::vtk::Scalar;
   switch (s) {
-    case Scalar::i8: return ScalarType::i8;
-    case Scalar::u8: return ScalarType::u8;
-    case Scalar::i16: return ScalarType::i16;
-    case Scalar::u16: return ScalarType::u16;
-    case Scalar::i32: return ScalarType::i32;
-    case Scalar::u32: return ScalarType::u32;
-    case Scalar::f32: return ScalarType::f32;
-    case Scalar::f64: return ScalarType::f64;
-    default: return std::nullopt;
+    case Scalar::i8:
+      return ScalarType::i8;
+    case Scalar::u8:
+      return ScalarType::u8;
+    case Scalar::i16:
+      return ScalarType::i16;
+    case Scalar::u16:
+      return ScalarType::u16;
+    case Scalar::i32:
+      return ScalarType::i32;
+    case Scalar::u32:
+      return ScalarType::u32;
+    case Scalar::f32:
+      return ScalarType::f32;
+    case Scalar::f64:
+      return ScalarType::f64;
+    default:
+      return std::nullopt;
   }
 }
 
@@ -57,12 +66,15 @@ LegacyHeader parse(const fs::path& file, std::string_view text) {
     sc.fail("not a legacy VTK file: the first line should be '# vtk DataFile Version x.x'");
   sc.rest_of_line();  // the title
   const std::string_view mode = sc.expect("ASCII or BINARY");
-  if (iequals(mode, "BINARY")) h.binary = true;
-  else if (!iequals(mode, "ASCII")) sc.fail(fmt::format("expected ASCII or BINARY, found '{}'", io::printable(mode)));
+  if (iequals(mode, "BINARY"))
+    h.binary = true;
+  else if (!iequals(mode, "ASCII"))
+    sc.fail(fmt::format("expected ASCII or BINARY, found '{}'", io::printable(mode)));
   if (!iequals(sc.expect("DATASET"), "DATASET")) sc.fail("expected DATASET");
   const std::string_view kind = sc.expect("the dataset type");
   if (!iequals(kind, "STRUCTURED_POINTS"))
-    sc.fail(fmt::format("isohex reads volumes from STRUCTURED_POINTS datasets; this file holds {}", io::printable(kind)));
+    sc.fail(
+        fmt::format("isohex reads volumes from STRUCTURED_POINTS datasets; this file holds {}", io::printable(kind)));
   bool dims_seen = false;
   while (true) {
     const std::string_view key = sc.expect("POINT_DATA");
@@ -87,8 +99,8 @@ LegacyHeader parse(const fs::path& file, std::string_view text) {
   bool sane = true;
   for (auto d : h.dims) sane = sane && d > 0 && d <= INT32_MAX;
   if (sane && n != h.dims[0] * h.dims[1] * h.dims[2])
-    sc.fail(fmt::format("POINT_DATA {} does not match DIMENSIONS {} x {} x {} = {}", n, h.dims[0], h.dims[1],
-                        h.dims[2], h.dims[0] * h.dims[1] * h.dims[2]));
+    sc.fail(fmt::format("POINT_DATA {} does not match DIMENSIONS {} x {} x {} = {}", n, h.dims[0], h.dims[1], h.dims[2],
+                        h.dims[0] * h.dims[1] * h.dims[2]));
   const std::string_view attr = sc.expect("SCALARS");
   if (iequals(attr, "COLOR_SCALARS")) {
     sc.expect("the COLOR_SCALARS name");
@@ -111,9 +123,10 @@ LegacyHeader parse(const fs::path& file, std::string_view text) {
   if (!vtk_type) sc.fail(fmt::format("SCALARS: unknown data type '{}'", io::printable(type_name)));
   const auto type = to_scalar_type(*vtk_type);
   if (!type)
-    sc.fail(fmt::format("SCALARS: data type '{}' is not supported (isohex reads 8- to 32-bit integers, float and "
-                        "double)",
-                        io::printable(type_name)));
+    sc.fail(
+        fmt::format("SCALARS: data type '{}' is not supported (isohex reads 8- to 32-bit integers, float and "
+                    "double)",
+                    io::printable(type_name)));
   h.type = *type;
   // An optional component count, then the end of the line.
   const std::string_view rest = trim(sc.rest_of_line());

@@ -1,0 +1,225 @@
+// isohex mesh VOLUME --iso V -o OUT: the uniform dual-contouring hex mesh of a volume (or of a
+// shape expression), with its quality summary and its distance to the isosurface.
+#include "commands.hpp"
+
+#include "isohex/contour/dual_contour.hpp"
+#include "isohex/error.hpp"
+#include "isohex/io/atomic_file.hpp"
+#include "isohex/io/mesh_io.hpp"
+#include "isohex/mesh/validate.hpp"
+#include "isohex/quality/summary.hpp"
+#include "isohex/volume/volume_io.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <ostream>
+#include <unistd.h>
+
+namespace isohex::cli {
+
+namespace {
+
+struct Args {
+  std::string volume, shape, output, json;
+  std::optional<double> iso, iso2;
+  std::string inside = "above", interpolation = "trilinear", region = "inside", outer;
+  double cell_size = 0;
+  Index resolution = 0, min_component = 0;
+  // Raw layout (as in `isohex volume info`).
+  std::vector<Index> dims;
+  std::string type, endian = "little";
+  std::vector<double> spacing, origin;
+  std::size_t header_bytes = 0;
+  int* threads = nullptr;
+};
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+VolumeReadOptions read_options(const Args& a) {
+  VolumeReadOptions opt;
+  if (a.dims.empty() && a.type.empty() && a.spacing.empty() && a.origin.empty() && a.header_bytes == 0) return opt;
+  if (a.dims.empty() || a.type.empty()) throw Error("raw layout options need at least --dims NX NY NZ and --type");
+  RawLayout raw;
+  raw.dims = {a.dims[0], a.dims[1], a.dims[2]};
+  raw.type = *scalar_type_from_name(a.type);
+  raw.big_endian = a.endian == "big";
+  if (!a.spacing.empty()) raw.spacing = Vec3(a.spacing[0], a.spacing[1], a.spacing[2]);
+  if (!a.origin.empty()) raw.origin = Vec3(a.origin[0], a.origin[1], a.origin[2]);
+  raw.header_bytes = a.header_bytes;
+  opt.raw = raw;
+  return opt;
+}
+
+// The shape's signed distance sampled at half the mesh cell size, so that the trilinear
+// interpolant follows the shape closely within each mesh cell.
+Volume sample_shape(const Args& a, double& cell_size) {
+  const Shape s = parse_shape(a.shape);
+  const Aabb box = sampling_bounds(s);
+  if (cell_size <= 0) cell_size = (box.hi - box.lo).maxCoeff() / (a.resolution > 0 ? a.resolution : 64);
+  return sample(s, grid_from_cell_size(box, cell_size / 2));
+}
+
+void print_summary(const MetricSummary& s) {
+  fmt::print("  scaled Jacobian: min {:.4g}  mean {:.4g}  max {:.4g}\n", s.min, s.mean, s.max);
+  fmt::print("  inverted (< 0): {}   questionable (< {}): {}   degenerate: {}\n", s.inverted, kQuestionableSJ,
+             s.questionable, s.degenerate);
+}
+
+void run(const Args& a) {
+  ThreadLimit limit(*a.threads);
+  if (a.volume.empty() == a.shape.empty()) throw Error("give either a VOLUME file or --shape EXPR (not both)");
+  if (!io::is_known_mesh_extension(a.output))
+    throw Error(fmt::format("{}: unknown mesh format (use .vtk .vtu .mesh .inp)", a.output));
+  const bool terminal = ::isatty(::fileno(stdout)) != 0;
+  const auto start = Clock::now();
+
+  contour::RegionSpec spec;
+  spec.kind = *contour::region_from_name(a.region);
+  spec.interpolation = *interpolation_from_name(a.interpolation);
+  spec.inside = *inside_from_name(a.inside);
+  double cell_size = a.cell_size;
+  Volume volume;
+  if (!a.shape.empty()) {
+    volume = sample_shape(a, cell_size);
+    spec.inside = Inside::below;  // signed distance: negative inside
+    spec.isovalue = a.iso.value_or(0);
+  } else {
+    if (!a.iso) throw Error("--iso V is required with a volume file");
+    volume = read_volume(a.volume, read_options(a));
+    spec.isovalue = *a.iso;
+  }
+  const double read_time = seconds_since(start);
+  if (spec.kind == contour::RegionKind::between) {
+    if (!a.iso2) throw Error("--region between needs --iso2 V2");
+    spec.isovalue2 = *a.iso2;
+  } else if (a.iso2) {
+    throw Error("--iso2 is only used with --region between");
+  }
+  if (!a.outer.empty()) {
+    if (spec.kind != contour::RegionKind::outside) throw Error("--outer is only used with --region outside");
+    spec.outer = contour::parse_outer(a.outer);
+  }
+  const contour::Region region = contour::make_region(volume, spec);
+
+  contour::ExtractOptions opt;
+  opt.cell_size = cell_size > 0 ? cell_size : 0;
+  if (opt.cell_size <= 0) {
+    if (a.resolution > 0) opt.resolution = a.resolution;
+    else opt.cell_size = volume.spacing.maxCoeff();  // one voxel
+  }
+  opt.min_component = a.min_component;
+  if (terminal) opt.on_stage = [](std::string_view s) { fmt::print("  {}...\n", s), std::fflush(stdout); };
+
+  fmt::print("{}: {} x {} x {} points, region {} ", a.shape.empty() ? a.volume : "shape", volume.dims[0],
+             volume.dims[1], volume.dims[2], a.region);
+  for (const auto& s : region.surfaces) fmt::print("[{}] ", s.describe());
+  fmt::print("\n");
+  const contour::ExtractResult out = contour::extract_hex_mesh(region, opt);
+  const contour::ExtractReport& r = out.report;
+  fmt::print("grid {} x {} x {} points, cell size {:.6g}\n", r.grid.points[0], r.grid.points[1], r.grid.points[2],
+             r.grid.h);
+
+  auto t = Clock::now();
+  const ValidationReport check = validate(out.mesh);
+  const contour::SurfaceDistance dist = contour::surface_distance(region, out.mesh, out.vertex_place);
+  const std::vector<double> sj = scaled_jacobians(out.mesh);
+  const MetricSummary summary = summarize(HexMetric::scaled_jacobian, sj);
+  const double check_time = seconds_since(t);
+  t = Clock::now();
+  io::write_mesh(a.output, out.mesh);
+  const double write_time = seconds_since(t);
+
+  fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
+             out.mesh.num_hexes(), out.mesh.num_vertices(), r.surface_vertices, r.box_vertices, check.num_boundary_quads);
+  fmt::print("  manifold repair: {} points made inside in {} rounds; {} cells split\n", r.filled_points,
+             r.repair_rounds, r.split_cells);
+  if (a.min_component > 1)
+    fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
+               r.dropped_hexes, a.min_component);
+  fmt::print("  boundary: {} components, Euler characteristic {}, {}\n", check.num_boundary_components,
+             check.euler_characteristic, check.valid() ? "valid conformal mesh, closed manifold" : "INVALID");
+  for (const Fault& f : check.faults)
+    if (is_error(f.kind)) fmt::print("    {}\n", f.message);
+  fmt::print("  distance to the isosurface: max |f - iso| / range = {:.3g} over {} vertices ({} above 1e-6; {} box "
+             "vertices not checked; {} projection fallbacks)\n",
+             dist.max_relative, dist.checked, dist.off_surface, dist.box_vertices, r.projection_fallbacks);
+  print_summary(summary);
+  fmt::print("times: read {:.3f} s, sample {:.3f} s, repair {:.3f} s, components {:.3f} s, vertices {:.3f} s, hexes "
+             "{:.3f} s, check {:.3f} s, write {:.3f} s\n",
+             read_time, r.time_sample, r.time_repair, r.time_components, r.time_vertices, r.time_hexes, check_time,
+             write_time);
+
+  if (!a.json.empty()) {
+    nlohmann::json j;
+    j["input"] = a.shape.empty() ? a.volume : a.shape;
+    j["region"] = a.region;
+    j["isovalue"] = spec.isovalue;
+    if (a.iso2) j["isovalue2"] = *a.iso2;
+    j["grid"] = {r.grid.points[0], r.grid.points[1], r.grid.points[2]};
+    j["cell_size"] = r.grid.h;
+    j["hexes"] = out.mesh.num_hexes();
+    j["vertices"] = out.mesh.num_vertices();
+    j["boundary_quads"] = check.num_boundary_quads;
+    j["boundary_components"] = check.num_boundary_components;
+    j["euler_characteristic"] = check.euler_characteristic;
+    j["valid"] = check.valid();
+    j["filled_points"] = r.filled_points;
+    j["split_cells"] = r.split_cells;
+    j["dropped_components"] = r.dropped_components;
+    j["dropped_hexes"] = r.dropped_hexes;
+    j["surface_vertices"] = r.surface_vertices;
+    j["box_vertices"] = r.box_vertices;
+    j["projection_fallbacks"] = r.projection_fallbacks;
+    j["max_relative_distance"] = dist.max_relative;
+    j["off_surface_vertices"] = dist.off_surface;
+    j["scaled_jacobian"] = to_json(summary);
+    j["times"] = {{"read", read_time},          {"sample", r.time_sample}, {"repair", r.time_repair},
+                  {"components", r.time_components}, {"vertices", r.time_vertices}, {"hexes", r.time_hexes},
+                  {"check", check_time},        {"write", write_time}};
+    io::write_atomically(a.json, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+  }
+  if (!check.valid() || dist.off_surface > 0) exit_code() = 1;
+}
+
+}  // namespace
+
+void register_mesh(CLI::App& app) {
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("mesh", "Uniform dual-contouring hex mesh of a volume's isosurface region");
+  cmd->add_option("volume", a->volume, "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)");
+  cmd->add_option("--shape", a->shape, "Mesh an implicit shape expression instead (inside where its distance < ISO, default 0)");
+  cmd->add_option("--iso", a->iso, "Isovalue");
+  cmd->add_option("--inside", a->inside, "Which side of the isovalue is the solid (default above)")
+      ->check(CLI::IsMember({"above", "below"}));
+  cmd->add_option("--interpolation", a->interpolation, "Values between samples (default trilinear)")
+      ->check(CLI::IsMember({"trilinear", "cubic", "smooth-cubic"}));
+  auto* cs = cmd->add_option("--cell-size", a->cell_size, "Hex size in world units (default: one voxel, the largest spacing)")
+                 ->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", a->resolution, "Cells along the longest axis of the domain")
+      ->check(CLI::PositiveNumber)
+      ->excludes(cs);
+  cmd->add_option("--region", a->region, "inside (default), outside (up to --outer), or between --iso and --iso2")
+      ->check(CLI::IsMember({"inside", "outside", "between"}));
+  cmd->add_option("--iso2", a->iso2, "Second isovalue of --region between");
+  cmd->add_option("--outer", a->outer, "Outer boundary of --region outside: sphere:CX,CY,CZ,R or box:X0,Y0,Z0,X1,Y1,Z1 "
+                                       "(default the volume's box)");
+  cmd->add_option("--min-component", a->min_component, "Drop connected parts with fewer hexes");
+  cmd->add_option("-o,--output", a->output, "Output mesh (.vtk .vtu .mesh .inp)")->required();
+  cmd->add_option("--json", a->json, "Write the report as JSON");
+  cmd->add_option("--dims", a->dims, "Raw files: grid points along x, y, z")->expected(3);
+  cmd->add_option("--type", a->type, "Raw files: the stored value type")
+      ->check(CLI::IsMember({"u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"}));
+  cmd->add_option("--endian", a->endian, "Raw files: byte order (default little)")->check(CLI::IsMember({"little", "big"}));
+  cmd->add_option("--spacing", a->spacing, "Raw files: distance between grid points (default 1 1 1)")->expected(3);
+  cmd->add_option("--origin", a->origin, "Raw files: position of the first grid point (default 0 0 0)")->expected(3);
+  cmd->add_option("--header-bytes", a->header_bytes, "Raw files: bytes to skip before the data");
+  a->threads = add_threads_option(cmd);
+  cmd->callback([a] { run(*a); });
+}
+
+}  // namespace isohex::cli

@@ -1,0 +1,100 @@
+#pragma once
+/// \file dual_contour.hpp
+/// \brief The uniform dual-contouring hex mesher (the "before" mesh of Shepherd et al. 2006,
+/// §2.3: LBIE-Mesher's uniform stage), with its boundary on the isosurface and always a
+/// closed, consistently oriented 2-manifold.
+///
+/// The region is sampled on a grid of cell size h centred in its domain box, with one layer
+/// of outside points around it. Every inside grid point becomes one hex whose 8 corners are
+/// the dual vertices of the 8 grid cells around it, in VTK order (positively oriented). A
+/// cell's dual vertex is
+///  - its centre when all 8 corners are inside;
+///  - otherwise (one vertex per inside component of the cell, see cell_cases.hpp) the
+///    minimiser of the QEF of the component's Hermite data (crossings on its edges by
+///    LevelSet::root, normals from the gradient), clamped to the cell, then projected onto
+///    the surface its crossings belong to (at most h away); if projection fails, the crossing
+///    nearest to the clamped point, which is on the surface.
+///
+/// Where the solid meets the domain box, cells reach past the box: their crossings with the
+/// padding layer lie on the box face. Such *box vertices* are put on the box face(s) and, if
+/// the cell also crosses the isosurface, moved within the face onto it. They are counted
+/// apart and not held to the on-surface check, since the box face, not the isosurface, is
+/// the boundary there.
+///
+/// Before vertices are placed, non-manifold cells are repaired by making outside points
+/// inside (cell_cases.hpp), repeated until none is left; this only adds points, so it ends.
+/// Every stage is parallel (oneTBB) and writes disjoint parts of its output, and vertices
+/// and hexes are numbered in grid order, so the mesh is the same bit for bit for any number
+/// of threads.
+
+#include "isohex/contour/region.hpp"
+#include "isohex/mesh/hex_mesh.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string_view>
+#include <vector>
+
+namespace isohex::contour {
+
+/// The sampling grid: `points` per axis, `h` apart, the first at `origin`.
+struct DualGrid {
+  std::array<Index, 3> points{1, 1, 1};
+  Vec3 origin{0, 0, 0};
+  double h = 1;
+};
+
+/// The grid of cell size `h` centred in `domain`: floor(extent / h) + 1 points per axis, all
+/// within the box (faces included). With the volume's box and h equal to its spacing the
+/// grid is the volume's own grid.
+DualGrid make_grid(const Aabb& domain, double h);
+
+/// Where a mesh vertex lies (ExtractResult::vertex_place); values ≥ 0 name a surface of the
+/// region (an index into Region::surfaces).
+enum : std::int8_t { kInteriorVertex = -1, kBoxVertex = -2 };
+
+struct ExtractOptions {
+  double cell_size = 0;      ///< h in world units; 0 = use `resolution`
+  Index resolution = 64;     ///< cells along the domain's longest axis when cell_size is 0
+  Index min_component = 0;   ///< drop connected parts with fewer hexes than this
+  /// Called as each stage starts ("sampling", "manifold repair", ...), e.g. for progress.
+  std::function<void(std::string_view stage)> on_stage;
+};
+
+/// What happened, with per-stage times in seconds.
+struct ExtractReport {
+  DualGrid grid;
+  std::size_t inside_points = 0;       ///< inside after repair and component removal
+  std::size_t filled_points = 0;       ///< made inside by the manifold repair
+  std::size_t repair_rounds = 0;
+  std::size_t dropped_components = 0;  ///< parts below min_component
+  std::size_t dropped_hexes = 0;
+  std::size_t components = 0;          ///< connected parts kept (counted when min_component > 1)
+  std::size_t split_cells = 0;         ///< cells with more than one dual vertex
+  std::size_t surface_vertices = 0;    ///< vertices on a surface of the region
+  std::size_t box_vertices = 0;        ///< vertices on the domain box (not checked against a surface)
+  std::size_t projection_fallbacks = 0;  ///< projection failed; the nearest crossing was used
+  double time_sample = 0, time_repair = 0, time_components = 0, time_vertices = 0, time_hexes = 0;
+};
+
+struct ExtractResult {
+  HexMesh mesh;
+  std::vector<std::int8_t> vertex_place;  ///< per vertex: surface index, kInteriorVertex or kBoxVertex
+  ExtractReport report;
+};
+
+/// Meshes `region`. Throws isohex::Error for a bad cell size or a grid over 2^31 vertices.
+ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& options);
+
+/// How far the surface vertices are from their surfaces.
+struct SurfaceDistance {
+  double max_relative = 0;      ///< max |L_k(v)| / scale (value range of an isosurface, radius of a sphere)
+  std::size_t checked = 0;      ///< surface vertices measured
+  std::size_t off_surface = 0;  ///< of those, relative distance above 1e-6
+  std::size_t box_vertices = 0; ///< vertices on the domain box, excluded
+};
+SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, const std::vector<std::int8_t>& vertex_place);
+
+}  // namespace isohex::contour

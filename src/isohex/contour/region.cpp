@@ -1,0 +1,167 @@
+#include "isohex/contour/region.hpp"
+
+#include "isohex/error.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+namespace isohex::contour {
+
+LevelSet::LevelSet(std::shared_ptr<const IsoField> field) : field_(std::move(field)) {
+  // The smoothing spline does not pass through the samples, so it is never snapped.
+  snap_to_grid_ = field_->interpolation() != Interpolation::smooth_cubic;
+  const double range = field_->value_range() > 0 ? field_->value_range() : std::max(1.0, std::abs(field_->isovalue()));
+  scale_ = range;
+  tolerance_ = 1e-7 * range;
+}
+
+LevelSet::LevelSet(const Vec3& center, double radius) : center_(center), radius_(radius), tolerance_(1e-10 * radius), scale_(radius) {}
+
+double LevelSet::level(const Vec3& p) const {
+  if (!field_) return radius_ - (p - center_).norm();
+  if (snap_to_grid_) {
+    const Volume& v = field_->volume();
+    const Vec3 g = grid_coordinates(v, p);
+    const Vec3 r = g.array().round();
+    if ((g - r).cwiseAbs().maxCoeff() < 1e-9 && (r.array() >= 0).all() && r.x() < v.dims[0] && r.y() < v.dims[1] &&
+        r.z() < v.dims[2])
+      return inside_level(v.at(static_cast<Index>(r.x()), static_cast<Index>(r.y()), static_cast<Index>(r.z())),
+                          field_->isovalue(), field_->inside());
+  }
+  return field_->level(p);
+}
+
+double LevelSet::level(const Vec3& p, Vec3& gradient) const {
+  if (!field_) {
+    const Vec3 d = p - center_;
+    const double n = d.norm();
+    gradient = n > 0 ? Vec3(-d / n) : Vec3(0, 0, 0);
+    return radius_ - n;
+  }
+  const double l = field_->level(p, gradient);
+  return snap_to_grid_ ? level(p) : l;
+}
+
+Vec3 LevelSet::root(const Vec3& a, const Vec3& b) const {
+  if (std::abs(level(b)) <= tolerance_) return b;
+  if (std::abs(level(a)) <= tolerance_) return a;
+  if (field_) return field_->root_on_segment(a, b, tolerance_);
+  // Sphere: |a + t (b − a) − c| = r, the root in [0, 1] (a is inside).
+  const Vec3 d = b - a, o = a - center_;
+  const double qa = d.squaredNorm(), qb = 2 * o.dot(d), qc = o.squaredNorm() - radius_ * radius_;
+  const double t = (-qb + std::sqrt(std::max(0.0, qb * qb - 4 * qa * qc))) / (2 * qa);
+  return a + std::clamp(t, 0.0, 1.0) * d;
+}
+
+bool LevelSet::project(Vec3& p, double max_distance) const {
+  if (std::abs(level(p)) <= tolerance_) return true;
+  if (field_) return field_->project(p, max_distance, tolerance_);
+  const Vec3 d = p - center_;
+  const double n = d.norm();
+  if (n == 0 || std::abs(n - radius_) > max_distance) return false;
+  p = center_ + d * (radius_ / n);
+  return true;
+}
+
+std::string LevelSet::describe() const {
+  if (!field_) return fmt::format("sphere ({:g}, {:g}, {:g}) radius {:g}", center_.x(), center_.y(), center_.z(), radius_);
+  return fmt::format("isosurface {:g} (inside {})", field_->isovalue(), inside_name(field_->inside()));
+}
+
+double Region::level(const Vec3& p) const {
+  double l = std::numeric_limits<double>::infinity();
+  for (const LevelSet& s : surfaces) l = std::min(l, s.level(p));
+  return l;
+}
+
+std::string_view region_name(RegionKind k) {
+  switch (k) {
+    case RegionKind::inside: return "inside";
+    case RegionKind::outside: return "outside";
+    case RegionKind::between: return "between";
+  }
+  return "inside";
+}
+
+std::optional<RegionKind> region_from_name(std::string_view name) {
+  for (RegionKind k : {RegionKind::inside, RegionKind::outside, RegionKind::between})
+    if (region_name(k) == name) return k;
+  return std::nullopt;
+}
+
+namespace {
+
+std::vector<double> parse_numbers(std::string_view text, std::string_view what) {
+  std::vector<double> out;
+  std::string s(text);
+  const char* p = s.c_str();
+  while (*p) {
+    char* end = nullptr;
+    const double v = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v)) throw Error(fmt::format("--outer {}: '{}' is not a list of numbers", what, text));
+    out.push_back(v);
+    p = end;
+    if (*p == ',') ++p;
+    else if (*p) throw Error(fmt::format("--outer {}: '{}' is not a comma-separated list of numbers", what, text));
+  }
+  return out;
+}
+
+Inside opposite(Inside i) { return i == Inside::above ? Inside::below : Inside::above; }
+
+}  // namespace
+
+OuterBoundary parse_outer(std::string_view text) {
+  OuterBoundary o;
+  if (text.starts_with("sphere:")) {
+    const auto v = parse_numbers(text.substr(7), "sphere");
+    if (v.size() != 4 || v[3] <= 0) throw Error("--outer sphere:CX,CY,CZ,R needs 4 numbers and R > 0");
+    o.kind = OuterBoundary::Kind::sphere;
+    o.center = Vec3(v[0], v[1], v[2]);
+    o.radius = v[3];
+  } else if (text.starts_with("box:")) {
+    const auto v = parse_numbers(text.substr(4), "box");
+    if (v.size() != 6 || !(v[0] < v[3] && v[1] < v[4] && v[2] < v[5]))
+      throw Error("--outer box:X0,Y0,Z0,X1,Y1,Z1 needs 6 numbers with X0 < X1, Y0 < Y1, Z0 < Z1");
+    o.kind = OuterBoundary::Kind::box;
+    o.box = Aabb{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
+  } else {
+    throw Error(fmt::format("--outer '{}': expected sphere:CX,CY,CZ,R or box:X0,Y0,Z0,X1,Y1,Z1", text));
+  }
+  return o;
+}
+
+Region make_region(const Volume& volume, const RegionSpec& spec) {
+  if (volume.size() == 0) throw Error("cannot mesh an empty volume");
+  Region r;
+  r.domain = Aabb{volume.origin, volume.max_corner()};
+  auto field = [&](double iso, Inside in) {
+    return LevelSet(std::make_shared<const IsoField>(volume, iso, in, spec.interpolation));
+  };
+  switch (spec.kind) {
+    case RegionKind::inside: r.surfaces.push_back(field(spec.isovalue, spec.inside)); break;
+    case RegionKind::outside:
+      r.surfaces.push_back(field(spec.isovalue, opposite(spec.inside)));
+      if (spec.outer.kind == OuterBoundary::Kind::sphere) {
+        r.surfaces.emplace_back(spec.outer.center, spec.outer.radius);
+        r.domain = Aabb{spec.outer.center.array() - spec.outer.radius, spec.outer.center.array() + spec.outer.radius};
+      } else if (spec.outer.kind == OuterBoundary::Kind::box) {
+        r.domain = spec.outer.box;
+      }
+      break;
+    case RegionKind::between: {
+      if (spec.isovalue == spec.isovalue2) throw Error("--region between needs two different isovalues");
+      const double lo = std::min(spec.isovalue, spec.isovalue2), hi = std::max(spec.isovalue, spec.isovalue2);
+      r.surfaces.push_back(field(lo, Inside::above));
+      r.surfaces.push_back(field(hi, Inside::below));
+      break;
+    }
+  }
+  return r;
+}
+
+}  // namespace isohex::contour

@@ -1,0 +1,58 @@
+#pragma once
+/// \file sampled_grid.hpp
+/// \brief The inside/outside classification of the dual-contouring grid, padded with a layer
+/// of outside points, and the edits made to it before meshing: manifold repair and removal
+/// of small components.
+
+#include "isohex/contour/dual_contour.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace isohex::contour {
+
+/// Inside flags on the grid padded by one point on every side. Padded index (I, J, K) is grid
+/// point (I − 1, J − 1, K − 1); points with a padded index 0 or P − 1 are padding, always
+/// outside. Cell (I, J, K) spans padded points I..I+1, J..J+1, K..K+1.
+struct SampledGrid {
+  DualGrid grid;
+  Aabb domain;
+  std::array<std::size_t, 3> padded{3, 3, 3};  ///< points per axis, padding included
+  std::vector<std::uint8_t> inside;             ///< 1 = inside, x fastest
+
+  [[nodiscard]] std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
+    return i + padded[0] * (j + padded[1] * k);
+  }
+  [[nodiscard]] std::size_t num_cells(int axis) const { return padded[axis] - 1; }
+  /// World position of padded point (i, j, k).
+  [[nodiscard]] Vec3 position(std::size_t i, std::size_t j, std::size_t k) const {
+    return grid.origin + grid.h * Vec3(static_cast<double>(i) - 1, static_cast<double>(j) - 1, static_cast<double>(k) - 1);
+  }
+  [[nodiscard]] bool is_padding(std::size_t i, std::size_t j, std::size_t k) const {
+    return i == 0 || j == 0 || k == 0 || i + 1 == padded[0] || j + 1 == padded[1] || k + 1 == padded[2];
+  }
+  /// Bit c set when corner c (offset (c&1, c>>1&1, c>>2&1)) of cell (i, j, k) is inside.
+  [[nodiscard]] std::uint8_t cell_mask(std::size_t i, std::size_t j, std::size_t k) const;
+  /// Bit c set when corner c of cell (i, j, k) is padding.
+  [[nodiscard]] std::uint8_t padding_mask(std::size_t i, std::size_t j, std::size_t k) const;
+};
+
+/// Samples the region at every grid point (in parallel). Throws isohex::Error if the grid
+/// would have more than 2^31 points.
+SampledGrid sample_region(const Region& region, const DualGrid& grid);
+
+/// Makes outside points inside until no cell is non-manifold (manifold_fill); returns the
+/// number of points added and sets `rounds`. Deterministic for any thread count.
+std::size_t repair_manifold(SampledGrid& g, std::size_t* rounds = nullptr);
+
+/// Labels the face-connected parts of the inside points (which are the connected parts of
+/// the hex mesh) and removes those with fewer than `min_points` points. Returns the numbers
+/// of parts removed and kept, and of points removed.
+struct ComponentCounts {
+  std::size_t removed = 0, kept = 0, removed_points = 0;
+};
+ComponentCounts remove_small_components(SampledGrid& g, std::size_t min_points);
+
+}  // namespace isohex::contour

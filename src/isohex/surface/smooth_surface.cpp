@@ -1,0 +1,242 @@
+#include "isohex/surface/smooth_surface.hpp"
+
+#include "isohex/error.hpp"
+#include "isohex/mesh/topology.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/summary.hpp"
+#include "isohex/surface/surface_graph.hpp"
+#include "isohex/surface/vertex_moves.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace isohex {
+
+using surface_detail::MoveContext;
+using surface_detail::MoveOutcome;
+
+namespace {
+
+constexpr double kSurfaceGuarantee = 1e-6;  // |L| ≤ this × range at the end (documented)
+
+void check_range(const char* name, double value, double lo, double hi) {
+  if (!(value >= lo && value <= hi))
+    throw Error(fmt::format("surface smoothing: option {} = {} is outside [{}, {}]", name, value, lo, hi));
+}
+
+void check_inputs(const HexMesh& mesh, const IsoField& field, const SurfaceSmoothingOptions& o) {
+  if (mesh.hexes.empty()) throw Error("surface smoothing: the mesh has no hexes");
+  const Index nv = mesh.num_vertices();
+  for (Index h = 0; h < mesh.num_hexes(); ++h)
+    for (int c = 0; c < 8; ++c)
+      if (mesh.hexes[h][c] < 0 || mesh.hexes[h][c] >= nv)
+        throw Error(fmt::format("surface smoothing: hex {}: vertex id {} at corner {} is out of range [0, {})", h,
+                                mesh.hexes[h][c], c, nv));
+  for (Index v = 0; v < nv; ++v)
+    if (!mesh.points[v].allFinite())
+      throw Error(fmt::format("surface smoothing: vertex {} has a non-finite coordinate", v));
+  if (mesh.has_fixed() && mesh.fixed.size() != mesh.points.size())
+    throw Error(fmt::format("surface smoothing: mesh.fixed has {} entries for {} vertices", mesh.fixed.size(), nv));
+  if (!o.pinned.empty() && o.pinned.size() != mesh.points.size())
+    throw Error(fmt::format("surface smoothing: the pinned mask has {} entries for {} vertices", o.pinned.size(), nv));
+
+  const Volume& vol = field.volume();
+  if (vol.dims[0] < 2 || vol.dims[1] < 2 || vol.dims[2] < 2)
+    throw Error(fmt::format("surface smoothing: the field's grid is {} x {} x {}; it needs at least 2 points per axis",
+                            vol.dims[0], vol.dims[1], vol.dims[2]));
+  if (vol.values.size() != vol.size())
+    throw Error(fmt::format("surface smoothing: the field has {} values for a {} x {} x {} grid ({} expected)",
+                            vol.values.size(), vol.dims[0], vol.dims[1], vol.dims[2], vol.size()));
+  if (!(field.value_range() > 0) || !std::isfinite(field.value_range()))
+    throw Error("surface smoothing: the field's values are all equal (or not finite): there is no isosurface");
+
+  check_range("iterations", o.iterations, 0, 1e6);
+  check_range("tangential_weight", o.tangential_weight, 0, 1);
+  check_range("normal_weight", o.normal_weight, 0, 0.5);
+  check_range("interior_weight", o.interior_weight, 0, 1);
+  check_range("interior_layers", o.interior_layers, 0, 1000);
+  check_range("interior_sweeps", o.interior_sweeps, 0, 1000);
+  check_range("min_hex_sj", o.min_hex_sj, 0, 1);
+  check_range("min_quad_sj", o.min_quad_sj, 0, 1);
+  check_range("max_halvings", o.max_halvings, 0, 60);
+  check_range("crease_angle_degrees", o.crease_angle_degrees, 1e-9, 180);
+  check_range("level_tolerance", o.level_tolerance, 1e-15, kSurfaceGuarantee);
+  check_range("projection_reach", o.projection_reach, 1e-6, 100);
+  check_range("convergence", o.convergence, 0, 1);
+}
+
+// A boundary vertex more than a cell outside the grid sees a clamped, flat field.
+void check_boundary_in_grid(const HexMesh& mesh, const std::vector<std::uint8_t>& on_boundary,
+                            const std::vector<std::uint8_t>& pinned, const Volume& vol) {
+  const Vec3 lo = vol.origin - vol.spacing, hi = vol.max_corner() + vol.spacing;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (!on_boundary[v] || pinned[v]) continue;
+    const Vec3& p = mesh.points[v];
+    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any())
+      throw Error(fmt::format("surface smoothing: boundary vertex {} at ({}, {}, {}) lies outside the field's grid "
+                              "[{}, {}] x [{}, {}] x [{}, {}]",
+                              v, p.x(), p.y(), p.z(), vol.origin.x(), vol.max_corner().x(), vol.origin.y(),
+                              vol.max_corner().y(), vol.origin.z(), vol.max_corner().z()));
+  }
+}
+
+SurfaceQuality quality_of(const HexMesh& mesh, const std::vector<Quad>& quads) {
+  SurfaceQuality q;
+  std::vector<double> qsj(quads.size());
+  tbb::parallel_for(std::size_t{0}, quads.size(), [&](std::size_t i) {
+    std::array<Vec3, 4> c;
+    for (int k = 0; k < 4; ++k) c[k] = mesh.points[quads[i][k]];
+    qsj[i] = quad_scaled_jacobian(c);
+  });
+  q.num_quads = quads.size();
+  q.quad_sj_min = quads.empty() ? 0 : std::numeric_limits<double>::infinity();
+  double sum = 0;  // sequential: the same mean for any thread count
+  for (double s : qsj) {
+    q.quad_sj_min = std::min(q.quad_sj_min, s);
+    sum += s;
+    if (s < kQuestionableSJ) ++q.quads_below;
+  }
+  q.quad_sj_mean = quads.empty() ? 0 : sum / static_cast<double>(quads.size());
+  const MetricSummary hs = summarize(HexMetric::scaled_jacobian, scaled_jacobians(mesh), 0);
+  q.hex_sj_min = hs.min;
+  q.hexes_inverted = hs.inverted;
+  q.hexes_degenerate = hs.degenerate;
+  return q;
+}
+
+// Runs `move` on every vertex of every class, classes in order, members in parallel, and
+// tallies the outcomes in member order.
+template <class Move>
+void sweep(const std::vector<std::vector<Index>>& classes, std::vector<MoveOutcome>& outcome,
+           SurfaceSmoothingReport& report, Move&& move) {
+  for (const auto& cls : classes) {
+    tbb::parallel_for(std::size_t{0}, cls.size(), [&](std::size_t i) { outcome[cls[i]] = move(cls[i]); });
+    for (Index v : cls) {
+      if (outcome[v] == MoveOutcome::halved) ++report.moves_halved;
+      if (outcome[v] == MoveOutcome::dropped) ++report.moves_dropped;
+    }
+  }
+}
+
+}  // namespace
+
+SurfaceQuality surface_quality(const HexMesh& mesh) { return quality_of(mesh, boundary_quads(mesh)); }
+
+std::vector<std::uint8_t> volume_box_vertices(const HexMesh& mesh, const Volume& volume, double relative_tolerance) {
+  const Vec3 lo = volume.origin, hi = volume.max_corner();
+  const double tol = relative_tolerance * (hi - lo).norm();
+  std::vector<std::uint8_t> mask(mesh.points.size(), 0);
+  const std::vector<std::uint8_t> boundary = boundary_vertex_mask(mesh);
+  for (std::size_t v = 0; v < mesh.points.size(); ++v) {
+    if (!boundary[v]) continue;
+    const Vec3& p = mesh.points[v];
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(p[a] - lo[a]) <= tol || std::abs(p[a] - hi[a]) <= tol) mask[v] = 1;
+  }
+  return mask;
+}
+
+SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, const SurfaceSmoothingOptions& options) {
+  check_inputs(mesh, field, options);
+  const Index nv = mesh.num_vertices();
+  std::vector<std::uint8_t> pinned(static_cast<std::size_t>(nv), 0);
+  for (Index v = 0; v < nv; ++v)
+    pinned[v] = (options.use_mesh_fixed && mesh.has_fixed() && mesh.fixed[v]) || (!options.pinned.empty() && options.pinned[v]);
+
+  const double crease_cos = std::cos(options.crease_angle_degrees * std::numbers::pi / 180.0);
+  const surface_detail::SurfaceGraph graph = surface_detail::build_surface_graph(mesh, crease_cos);
+  check_boundary_in_grid(mesh, graph.on_boundary, pinned, field.volume());
+
+  SurfaceSmoothingReport report;
+  report.before = quality_of(mesh, graph.quads);
+
+  // Free boundary vertices: sliding ones and crease ones (projection only).
+  std::vector<Index> boundary;
+  for (Index v = 0; v < nv; ++v) {
+    if (pinned[v]) ++report.pinned_vertices;
+    if (!graph.on_boundary[v] || pinned[v]) continue;
+    boundary.push_back(v);
+    if (graph.on_crease[v]) ++report.crease_vertices;
+  }
+  report.boundary_vertices = static_cast<std::size_t>(
+      std::count_if(graph.on_boundary.begin(), graph.on_boundary.end(), [](std::uint8_t b) { return b != 0; }));
+  const std::vector<Index> band = surface_detail::interior_band(mesh, graph, options.interior_layers, pinned);
+  report.interior_vertices = band.size();
+  const auto boundary_classes = surface_detail::colour_classes(boundary, mesh, graph.vertex_hexes);
+  const auto interior_classes = surface_detail::colour_classes(band, mesh, graph.vertex_hexes);
+  report.colours = boundary_classes.size() + interior_classes.size();
+
+  // Mean boundary edge length: the scale of the convergence test.
+  double edge_sum = 0;
+  std::size_t edge_count = 0;
+  for (Index v = 0; v < nv; ++v)
+    for (Index k = graph.boundary_neighbours.offsets[v]; k < graph.boundary_neighbours.offsets[v + 1]; ++k)
+      if (graph.boundary_neighbours.ids[k] > v) {
+        edge_sum += (mesh.points[graph.boundary_neighbours.ids[k]] - mesh.points[v]).norm();
+        ++edge_count;
+      }
+  const double mean_edge = edge_count > 0 ? edge_sum / static_cast<double>(edge_count) : 0.0;
+
+  // The projection phase's hard floors: no new inverted hex or boundary quad.
+  MoveContext ctx{mesh, graph, field, options.min_hex_sj, options.min_quad_sj, 0.0, options.max_halvings,
+                  options.level_tolerance * field.value_range(), options.projection_reach};
+  const std::vector<Vec3> start = mesh.points;
+  std::vector<double> curvature(static_cast<std::size_t>(nv), 0.0);
+  std::vector<MoveOutcome> outcome(static_cast<std::size_t>(nv), MoveOutcome::none);
+  std::vector<Vec3> before_iteration;
+
+  // Onto the isosurface first: the relaxation's guarantees start from the projected mesh.
+  sweep(boundary_classes, outcome, report,
+        [&](Index v) { return surface_detail::move_boundary_vertex(ctx, v, Vec3::Zero()); });
+  report.projected = quality_of(mesh, graph.quads);
+  ctx.quad_hard_floor = report.projected.quad_sj_min;
+
+  for (int it = 0; it < options.iterations; ++it) {
+    before_iteration = mesh.points;
+    // Curvatures from one snapshot (Jacobi), so every vertex sees the same H field.
+    if (options.normal_weight > 0)
+      tbb::parallel_for(std::size_t{0}, boundary.size(), [&](std::size_t i) {
+        const Index v = boundary[i];
+        curvature[v] = surface_detail::quad_umbrella(ctx, v).dot(surface_detail::outward_normal(ctx, v));
+      });
+    sweep(boundary_classes, outcome, report, [&](Index v) {
+      const Vec3 step = graph.on_crease[v] ? Vec3::Zero()
+                                           : surface_detail::boundary_step(ctx, v, curvature, options.tangential_weight,
+                                                                           options.normal_weight);
+      return surface_detail::move_boundary_vertex(ctx, v, step);
+    });
+    for (int s = 0; s < options.interior_sweeps; ++s)
+      sweep(interior_classes, outcome, report, [&](Index v) {
+        return surface_detail::move_interior_vertex(ctx, v, surface_detail::interior_step(ctx, v, options.interior_weight));
+      });
+    report.iterations = it + 1;
+    double moved = 0;
+    for (Index v = 0; v < nv; ++v) moved = std::max(moved, (mesh.points[v] - before_iteration[v]).norm());
+    if (moved <= options.convergence * mean_edge) {
+      report.converged = true;
+      break;
+    }
+  }
+
+  // Whatever the iterations did (or if there were none), end on the isosurface where allowed.
+  sweep(boundary_classes, outcome, report,
+        [&](Index v) { return surface_detail::move_boundary_vertex(ctx, v, Vec3::Zero()); });
+
+  const double guarantee = kSurfaceGuarantee * field.value_range();
+  for (Index v : boundary) {
+    const double l = std::abs(field.level(mesh.points[v]));
+    report.max_level = std::max(report.max_level, l);
+    if (l > guarantee) ++report.off_surface;
+  }
+  report.max_level_relative = report.max_level / field.value_range();
+  for (Index v = 0; v < nv; ++v) report.max_displacement = std::max(report.max_displacement, (mesh.points[v] - start[v]).norm());
+  report.after = quality_of(mesh, graph.quads);
+  return report;
+}
+
+}  // namespace isohex
