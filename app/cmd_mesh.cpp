@@ -7,6 +7,7 @@
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/validate.hpp"
+#include "isohex/surface/smooth_surface.hpp"
 #include "isohex/quality/summary.hpp"
 #include "isohex/volume/volume_io.hpp"
 
@@ -34,6 +35,8 @@ struct Args {
   std::string type, endian = "little";
   std::vector<double> spacing, origin;
   std::size_t header_bytes = 0;
+  bool no_surface_smoothing = false;
+  int surface_iterations = 30;
   int* threads = nullptr;
 };
 
@@ -62,6 +65,50 @@ Volume sample_shape(const Args& a, double& cell_size) {
   const Aabb box = sampling_bounds(s);
   if (cell_size <= 0) cell_size = (box.hi - box.lo).maxCoeff() / (a.resolution > 0 ? a.resolution : 64);
   return sample(s, grid_from_cell_size(box, cell_size / 2));
+}
+
+// Smooths the boundary on each isosurface of the region in turn. Vertices of the other
+// surfaces and of the domain box are pinned, so each surface keeps its own vertices on it.
+std::vector<SurfaceSmoothingReport> smooth_surfaces(const contour::Region& region, contour::ExtractResult& out,
+                                                    int iterations, bool terminal) {
+  std::vector<SurfaceSmoothingReport> reports;
+  for (std::size_t k = 0; k < region.surfaces.size(); ++k) {
+    const IsoField* field = region.surfaces[k].field();
+    if (!field) {
+      reports.emplace_back();  // an analytic sphere: its vertices are exact already
+      continue;
+    }
+    if (terminal) fmt::print("  surface smoothing on {}...\n", region.surfaces[k].describe()), std::fflush(stdout);
+    SurfaceSmoothingOptions opt;
+    opt.iterations = iterations;
+    opt.pinned.assign(out.mesh.points.size(), 0);
+    for (std::size_t v = 0; v < out.vertex_place.size(); ++v) {
+      const std::int8_t place = out.vertex_place[v];
+      opt.pinned[v] = place == contour::kBoxVertex || (place >= 0 && place != static_cast<std::int8_t>(k));
+    }
+    reports.push_back(smooth_surface(out.mesh, *field, opt));
+  }
+  return reports;
+}
+
+void print_smoothing(const contour::LevelSet& surface, const SurfaceSmoothingReport& s) {
+  if (!surface.field()) return;
+  fmt::print("surface smoothing on {}: {} iterations{}; boundary quad SJ min {:.4g} -> {:.4g}, mean {:.4g} -> {:.4g}, "
+             "< {}: {} -> {}; hexes inverted {} -> {}\n",
+             surface.describe(), s.iterations, s.converged ? " (converged)" : "", s.before.quad_sj_min,
+             s.after.quad_sj_min, s.before.quad_sj_mean, s.after.quad_sj_mean, kQuestionableSJ, s.before.quads_below,
+             s.after.quads_below, s.before.hexes_inverted, s.after.hexes_inverted);
+}
+
+nlohmann::json smoothing_json(const contour::LevelSet& surface, const SurfaceSmoothingReport& s) {
+  auto q = [](const SurfaceQuality& x) {
+    return nlohmann::json{{"boundary_quad_sj_min", x.quad_sj_min}, {"boundary_quad_sj_mean", x.quad_sj_mean},
+                          {"boundary_quads_below_0.2", x.quads_below}, {"hex_sj_min", x.hex_sj_min},
+                          {"hexes_inverted", x.hexes_inverted}};
+  };
+  return {{"surface", surface.describe()}, {"smoothed", surface.field() != nullptr}, {"iterations", s.iterations},
+          {"converged", s.converged}, {"before", q(s.before)}, {"after", q(s.after)},
+          {"max_level_relative", s.max_level_relative}, {"max_displacement", s.max_displacement}};
 }
 
 void print_summary(const MetricSummary& s) {
@@ -119,12 +166,18 @@ void run(const Args& a) {
              volume.dims[1], volume.dims[2], a.region);
   for (const auto& s : region.surfaces) fmt::print("[{}] ", s.describe());
   fmt::print("\n");
-  const contour::ExtractResult out = contour::extract_hex_mesh(region, opt);
+  contour::ExtractResult out = contour::extract_hex_mesh(region, opt);
   const contour::ExtractReport& r = out.report;
   fmt::print("grid {} x {} x {} points, cell size {:.6g}\n", r.grid.points[0], r.grid.points[1], r.grid.points[2],
              r.grid.h);
 
   auto t = Clock::now();
+  const std::vector<SurfaceSmoothingReport> smoothing =
+      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations, terminal);
+  const double smooth_time = seconds_since(t);
+  for (std::size_t k = 0; k < smoothing.size(); ++k) print_smoothing(region.surfaces[k], smoothing[k]);
+
+  t = Clock::now();
   const ValidationReport check = validate(out.mesh);
   const contour::SurfaceDistance dist = contour::surface_distance(region, out.mesh, out.vertex_place);
   const std::vector<double> sj = scaled_jacobians(out.mesh);
@@ -150,9 +203,9 @@ void run(const Args& a) {
              dist.max_relative, dist.checked, dist.off_surface, dist.box_vertices, r.projection_fallbacks);
   print_summary(summary);
   fmt::print("times: read {:.3f} s, sample {:.3f} s, repair {:.3f} s, components {:.3f} s, vertices {:.3f} s, hexes "
-             "{:.3f} s, check {:.3f} s, write {:.3f} s\n",
-             read_time, r.time_sample, r.time_repair, r.time_components, r.time_vertices, r.time_hexes, check_time,
-             write_time);
+             "{:.3f} s, surface smoothing {:.3f} s, check {:.3f} s, write {:.3f} s\n",
+             read_time, r.time_sample, r.time_repair, r.time_components, r.time_vertices, r.time_hexes, smooth_time,
+             check_time, write_time);
 
   if (!a.json.empty()) {
     nlohmann::json j;
@@ -180,7 +233,10 @@ void run(const Args& a) {
     j["scaled_jacobian"] = to_json(summary);
     j["times"] = {{"read", read_time},          {"sample", r.time_sample}, {"repair", r.time_repair},
                   {"components", r.time_components}, {"vertices", r.time_vertices}, {"hexes", r.time_hexes},
-                  {"check", check_time},        {"write", write_time}};
+                  {"surface_smoothing", smooth_time}, {"check", check_time}, {"write", write_time}};
+    nlohmann::json sm = nlohmann::json::array();
+    for (std::size_t k = 0; k < smoothing.size(); ++k) sm.push_back(smoothing_json(region.surfaces[k], smoothing[k]));
+    j["surface_smoothing"] = sm;
     io::write_atomically(a.json, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
   }
   if (!check.valid() || dist.off_surface > 0) exit_code() = 1;
@@ -209,6 +265,10 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--outer", a->outer, "Outer boundary of --region outside: sphere:CX,CY,CZ,R or box:X0,Y0,Z0,X1,Y1,Z1 "
                                        "(default the volume's box)");
   cmd->add_option("--min-component", a->min_component, "Drop connected parts with fewer hexes");
+  cmd->add_flag("--no-surface-smoothing", a->no_surface_smoothing,
+                "Skip the geometric-flow smoothing of the boundary quads (on by default; vertices stay on the isosurface)");
+  cmd->add_option("--surface-iterations", a->surface_iterations, "Iterations of the surface smoothing (default 30)")
+      ->check(CLI::Range(0, 10000));
   cmd->add_option("-o,--output", a->output, "Output mesh (.vtk .vtu .mesh .inp)")->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
   cmd->add_option("--dims", a->dims, "Raw files: grid points along x, y, z")->expected(3);
