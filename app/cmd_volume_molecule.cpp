@@ -45,14 +45,6 @@ void print_read_report(const Molecule& m) {
                r.default_radius_atoms, fmt::join(r.unknown_elements, " "), MoleculeReadOptions{}.default_radius);
 }
 
-// Fails before any work if the output is not a writable volume format.
-void require_volume_output(const std::string& file) {
-  std::string ext = std::filesystem::path(file).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".nrrd" && ext != ".vti")
-    throw Error(fmt::format("{}: cannot write volume format '{}' (writable: .nrrd .vti)", file, ext));
-}
-
 void run(const Args& a) {
   ThreadLimit limit(*a.threads);
   require_volume_output(a.output);

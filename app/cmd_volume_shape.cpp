@@ -50,14 +50,6 @@ std::size_t inside_on_boundary(const Volume& v) {
   return n;
 }
 
-// Fails before any work if the output is not a writable volume format.
-void require_volume_output(const std::string& file) {
-  std::string ext = std::filesystem::path(file).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".nrrd" && ext != ".vti")
-    throw Error(fmt::format("{}: cannot write volume format '{}' (writable: .nrrd .vti)", file, ext));
-}
-
 void run(const Args& a) {
   ThreadLimit limit(*a.threads);
   require_volume_output(a.output);

@@ -27,6 +27,9 @@ namespace isohex::cli {
 /// Reads a mesh for a command; prints how many non-hex cells were dropped, if any.
 HexMesh load_mesh(const std::string& file, bool skip_non_hex);
 
+/// Fails before any work if `file` is not a writable volume format (.nrrd, .vti).
+void require_volume_output(const std::string& file);
+
 /// Adds `--threads N` (0 = all cores) and returns where its value goes.
 int* add_threads_option(CLI::App* cmd);
 

@@ -1,10 +1,14 @@
 // Pieces the subcommands share: loading a mesh, the thread limit.
 #include "commands.hpp"
 
+#include "isohex/error.hpp"
 #include "isohex/io/mesh_io.hpp"
 
 #include <fmt/format.h>
 #include <tbb/global_control.h>
+
+#include <cctype>
+#include <filesystem>
 
 namespace isohex::cli {
 
@@ -16,6 +20,13 @@ HexMesh load_mesh(const std::string& file, bool skip_non_hex) {
   if (report.skipped_cells)
     fmt::print("{}: skipped {} non-hexahedral cells (--skip-non-hex)\n", file, report.skipped_cells);
   return mesh;
+}
+
+void require_volume_output(const std::string& file) {
+  std::string ext = std::filesystem::path(file).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".nrrd" && ext != ".vti")
+    throw Error(fmt::format("{}: cannot write volume format '{}' (writable: .nrrd .vti)", file, ext));
 }
 
 int* add_threads_option(CLI::App* cmd) {

@@ -11,10 +11,7 @@
 using namespace isohex;
 using isohex::test::run_cli;
 using isohex::test::scratch_dir;
-
-namespace {
-std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
-}  // namespace
+constexpr auto q = isohex::test::quote;
 
 TEST(Cli, HelpListsEverySubcommand) {
   std::string out;

@@ -47,13 +47,6 @@ HexMesh two_hexes(std::vector<Index> blocks = {5, 2}) {
   return m;
 }
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
 TEST(Abaqus, AutomeshFilesLoad) {
   ISOHEX_REQUIRE_SHARED_DATA();
   ReadReport report;

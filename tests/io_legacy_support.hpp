@@ -25,6 +25,14 @@ namespace isohex::test {
 
 namespace fs = std::filesystem;
 
+/// `text` with the first `from` replaced by `to` (a test failure if `from` is absent).
+inline std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
 inline void write_text(const fs::path& file, const std::string& bytes) {
   fs::remove(file);  // much faster than truncating in place on some file systems
   std::ofstream out(file, std::ios::binary);

@@ -41,13 +41,6 @@ Hexahedra
 End
 )";
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
 TEST(Medit, EcrFilesLoadWithTheirCounts) {
   ISOHEX_REQUIRE_SHARED_DATA();
   struct Counts {

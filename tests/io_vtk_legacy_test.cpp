@@ -45,13 +45,6 @@ HexMesh two_hexes() {
   return m;
 }
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
 /// Builds legacy files whose arrays are written either as ASCII numbers or as big-endian
 /// bytes, so one description yields both variants.
 class VtkBuilder {

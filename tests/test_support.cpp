@@ -30,6 +30,8 @@ HexMesh grid_mesh(int nx, int ny, int nz, double h) {
   return box_mesh(nx, ny, nz, Vec3::Zero(), Vec3(nx * h, ny * h, nz * h));
 }
 
+std::string quote(const fs::path& path) { return "'" + path.string() + "'"; }
+
 int run_cli(const std::string& args, std::string* output) {
   const std::string cmd = std::string(ISOHEX_CLI) + " " + args + " 2>&1";
   FILE* pipe = ::popen(cmd.c_str(), "r");

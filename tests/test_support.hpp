@@ -16,6 +16,8 @@ bool have_shared_data();
 std::filesystem::path scratch_dir();
 /// An nx*ny*nz grid of unit-spaced hexes (spacing h), vertices numbered x fastest.
 HexMesh grid_mesh(int nx, int ny, int nz, double h = 1.0);
+/// `path` in single quotes, for run_cli command lines.
+std::string quote(const std::filesystem::path& path);
 /// Runs the isohex CLI with `args` (a shell-quoted string); returns the exit code and
 /// captures stdout+stderr into `output`.
 int run_cli(const std::string& args, std::string* output = nullptr);
