@@ -80,3 +80,14 @@ TEST(Summary, EmptyMeshIsHarmless) {
   EXPECT_TRUE(s.worst.empty());
   EXPECT_FALSE(histogram_svg(s).empty());
 }
+
+TEST(Summary, TallestBarStaysInsideThePlot) {
+  std::vector<double> v(3500, 0.95);
+  v.push_back(0.1);
+  const std::string svg = histogram_svg(summarize(HexMetric::scaled_jacobian, v));
+  // Every bar's top edge (y attribute) is at or below the plot's top margin (y = 60).
+  for (std::size_t p = svg.find("<rect x="); p != std::string::npos; p = svg.find("<rect x=", p + 1)) {
+    const std::size_t y = svg.find("y=\"", p) + 3;
+    EXPECT_GE(std::stod(svg.substr(y, 12)), 60.0 - 1e-9);
+  }
+}

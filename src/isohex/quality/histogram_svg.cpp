@@ -39,7 +39,11 @@ std::vector<double> linear_ticks(double top) {
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
   const double step = raw <= p ? p : raw <= 2 * p ? 2 * p : raw <= 5 * p ? 5 * p : 10 * p;
   std::vector<double> t;
-  for (double v = 0; v <= top * 1.0001; v += step) t.push_back(v);
+  // Up to the first tick at or above `top`, so that the tallest bar stays inside the plot.
+  for (double v = 0;; v += step) {
+    t.push_back(v);
+    if (v >= top) break;
+  }
   return t;
 }
 
