@@ -12,6 +12,9 @@ void register_check(CLI::App& app);
 void register_convert(CLI::App& app);
 void register_generate(CLI::App& app);
 void register_mesh(CLI::App& app);
+void register_pillow(CLI::App& app);
+void register_sheets(CLI::App& app);
+void register_smooth(CLI::App& app);
 
 /// The exit code a command asks for (0 unless a command reports a failed check).
 int& exit_code();

@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
   isohex::cli::register_convert(app);
   isohex::cli::register_generate(app);
   isohex::cli::register_mesh(app);
+  isohex::cli::register_pillow(app);
+  isohex::cli::register_sheets(app);
+  isohex::cli::register_smooth(app);
   isohex::cli::register_volume(app);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,248 @@
+// Frames, per-frame energies with exact derivatives, per-vertex Newton moves, sweeps.
+#include "isohex/optimize/local_energy.hpp"
+
+#include "isohex/quality/hex_quality.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace isohex::opt {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// c_{t,k} for the 8 corner frames and the centre frame (principal axes / 4).
+std::array<std::array<Vec3, 8>, kFrames> make_coefficients() {
+  std::array<std::array<Vec3, 8>, kFrames> c;
+  for (auto& row : c) row.fill(Vec3::Zero());
+  for (int t = 0; t < 8; ++t) {
+    c[t][t] = Vec3(-1, -1, -1);
+    for (int j = 0; j < 3; ++j) c[t][kCornerNeighbors[t][j]][j] = 1;
+  }
+  for (int k = 0; k < 8; ++k) {
+    const bool x = k == 1 || k == 2 || k == 5 || k == 6;
+    const bool y = k == 2 || k == 3 || k == 6 || k == 7;
+    const bool z = k >= 4;
+    c[kCentreFrame][k] = 0.25 * Vec3(x ? 1 : -1, y ? 1 : -1, z ? 1 : -1);
+  }
+  return c;
+}
+const std::array<std::array<Vec3, 8>, kFrames> kCoef = make_coefficients();
+
+// The scalar derivatives of one frame's energy f(F, D), F = |A|², D = det A.
+struct Scalar {
+  double f = 0, fF = 0, fD = 0, fFD = 0, fDD = 0;
+};
+
+// Regularised energy (ε > 0): finite for every D, so the untangler may cross inverted states.
+Scalar untangle_term(double F, double D, double eps, double lambda) {
+  const double s = std::sqrt(eps * eps + D * D);
+  // (D + s)/2 cancels for D << 0; the same value as ε²/(2(s − D)) there.
+  const double chi = D >= 0 ? 0.5 * (D + s) : eps * eps / (2 * (s - D));
+  const double chi1 = chi / s;                      // dχ/dD
+  const double chi2 = eps * eps / (2 * s * s * s);  // d²χ/dD²
+  const double c23 = std::pow(chi, -2.0 / 3.0), c53 = c23 / chi, c83 = c53 / chi;
+  const double q = D * D + 1;
+  Scalar r;
+  r.f = F * c23 / 3 + lambda * q / chi;
+  r.fF = c23 / 3;
+  r.fFD = -(2.0 / 9.0) * c53 * chi1;
+  r.fD = F * r.fFD + lambda * (2 * D / chi - q * chi1 / (chi * chi));
+  r.fDD = F / 3 * ((10.0 / 9.0) * c83 * chi1 * chi1 - (2.0 / 3.0) * c53 * chi2) +
+          lambda * (2 / chi - 4 * D * chi1 / (chi * chi) + 2 * q * chi1 * chi1 / (chi * chi * chi) - q * chi2 / (chi * chi));
+  return r;
+}
+
+// Knupp's inverse mean ratio F / (3 D^{2/3}); a barrier: +inf unless D is safely positive.
+Scalar shape_term(double F, double D) {
+  Scalar r;
+  if (!(D > kMinFeasibleDet)) {
+    r.f = kInf;
+    return r;
+  }
+  const double c23 = std::pow(D, -2.0 / 3.0), c53 = c23 / D, c83 = c53 / D;
+  r.f = F * c23 / 3;
+  r.fF = c23 / 3;
+  r.fFD = -(2.0 / 9.0) * c53;
+  r.fD = F * r.fFD;
+  r.fDD = F * (10.0 / 27.0) * c83;
+  return r;
+}
+
+Scalar term(const Mat3& A, int t, const EnergyParams& params) {
+  const double F = A.squaredNorm(), D = A.determinant();
+  if (params.untangle) return untangle_term(F, D, params.eps, params.lambda);
+  if (t == kCentreFrame) {  // the centre frame only constrains (validity), it is not optimised
+    Scalar r;
+    if (!(D > kMinFeasibleDet)) r.f = kInf;
+    return r;
+  }
+  return shape_term(F, D);
+}
+
+}  // namespace
+
+const Vec3& frame_coefficient(int t, int k) { return kCoef[t][k]; }
+
+std::vector<double> inverse_edge_lengths(const HexMesh& mesh) {
+  std::vector<double> inv(mesh.hexes.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h) {
+      double sum = 0;
+      for (const auto& e : kHexEdges) sum += (mesh.points[mesh.hexes[h][e[0]]] - mesh.points[mesh.hexes[h][e[1]]]).norm();
+      // A fully collapsed hex has no size of its own: 1 keeps the arithmetic finite.
+      inv[h] = sum > 0 ? 12.0 / sum : 1.0;
+    }
+  });
+  return inv;
+}
+
+Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+  Mat3 A;
+  if (t < 8) {
+    const auto& nb = kCornerNeighbors[t];
+    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
+  } else {
+    A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
+    A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
+    A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
+  }
+  return A;
+}
+
+double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params) {
+  double e = 0;
+  for (int t = 0; t < kFrames; ++t) e += term(frame(p, t, inv_len), t, params).f;
+  return e;
+}
+
+bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len) {
+  for (int t = 0; t < kFrames; ++t)
+    if (!(frame(p, t, inv_len).determinant() > kMinFeasibleDet)) return false;
+  return true;
+}
+
+double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
+                     const Vec3& x, const EnergyParams& params, Vec3* g, Mat3* H) {
+  double e = 0;
+  if (g) g->setZero();
+  if (H) H->setZero();
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const Index h = inc.ids[i];
+    std::array<Vec3, 8> p = mesh.corners(h);
+    int k = 0;
+    while (mesh.hexes[h][k] != v) ++k;
+    p[k] = x;
+    const double il = inv_len[h];
+    for (int t = 0; t < kFrames; ++t) {
+      const Vec3& c = kCoef[t][k];
+      if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
+      const Mat3 A = frame(p, t, il);
+      const Scalar s = term(A, t, params);
+      e += s.f;
+      if (!std::isfinite(e)) return kInf;
+      if (!g) continue;
+      // d/dx of F and D: A changes by il·dx cᵀ.
+      const Vec3 gF = 2 * il * (A * c);
+      const Vec3 gD = il * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) +
+                            c[2] * A.col(0).cross(A.col(1)));
+      *g += s.fF * gF + s.fD * gD;
+      if (H) {
+        *H += (s.fF * 2 * il * il * c.squaredNorm()) * Mat3::Identity();
+        *H += s.fFD * (gF * gD.transpose() + gD * gF.transpose()) + s.fDD * (gD * gD.transpose());
+      }
+    }
+  }
+  return e;
+}
+
+Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
+                 const EnergyParams& params) {
+  Move m{mesh.points[v], 0, false};
+  Vec3 g;
+  Mat3 H;
+  const double e0 = vertex_energy(mesh, inc, inv_len, v, m.x, params, &g, &H);
+  if (!std::isfinite(e0) || inc.count(v) == 0) return m;
+  double len = 0;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) len += 1 / inv_len[inc.ids[i]];
+  len /= static_cast<double>(inc.count(v));
+  m.grad = g.norm() * len;
+  if (!(m.grad > 0)) return m;
+  // Newton direction on the Hessian with its eigenvalues clamped positive (the regularised
+  // energy is not convex); a curvature floor from the gradient scale keeps the step bounded.
+  Eigen::SelfAdjointEigenSolver<Mat3> es(H);
+  Vec3 lam = es.eigenvalues();
+  const double floor = std::max(1e-6 * lam.cwiseAbs().maxCoeff(), 1e-3 * g.norm() / len);
+  for (int i = 0; i < 3; ++i) lam[i] = std::max(lam[i], floor);
+  Vec3 d = -(es.eigenvectors() * (es.eigenvectors().transpose() * g).cwiseQuotient(lam));
+  const double dn = d.norm();
+  if (dn > len) d *= len / dn;  // never jump further than an edge in one step
+  const double slope = g.dot(d);
+  double t = 1;
+  for (int i = 0; i < 30; ++i, t *= 0.5) {
+    const Vec3 x = m.x + t * d;
+    const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
+    if (e < e0 && e <= e0 + 1e-4 * t * slope) {
+      m.x = x;
+      m.moved = true;
+      break;
+    }
+  }
+  return m;
+}
+
+double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, const EnergyParams& params,
+                    const std::vector<std::uint8_t>& skip) {
+  std::vector<double> e(mesh.hexes.size(), 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h)
+      if (skip.empty() || !skip[h]) e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), inv_len[h], params);
+  });
+  double sum = 0;
+  for (double x : e) sum += x;  // in hex order: the same bits for any thread count
+  return sum;
+}
+
+double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc, const std::vector<double>& inv_len,
+             const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps) {
+  double max_grad = 0;
+  std::vector<double> grad;
+  for (const std::vector<Index>& color : coloring.colors) {
+    grad.assign(color.size(), 0.0);
+    // Vertices of one colour share no hex: each move reads only vertices of other colours,
+    // so moving them concurrently gives the same result as any sequential order.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, color.size(), 16), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const Index v = color[i];
+        if (!frozen.empty() && frozen[v]) continue;
+        for (int s = 0; s < steps; ++s) {
+          const Move m = newton_move(mesh, inc, inv_len, v, params);
+          if (s == 0) grad[i] = m.grad;
+          if (!m.moved) break;
+          mesh.points[v] = m.x;
+        }
+      }
+    });
+    for (double x : grad) max_grad = std::max(max_grad, x);
+  }
+  return max_grad;
+}
+
+SJStats sj_stats(const HexMesh& mesh) {
+  SJStats s;
+  s.min = mesh.hexes.empty() ? 1.0 : kVerdictDblMax;
+  for (double v : scaled_jacobians(mesh)) {
+    if (is_degenerate(v)) v = -1;  // a collapsed edge is as bad as an inverted corner
+    s.min = std::min(s.min, v);
+    s.inverted += v <= 0;
+  }
+  return s;
+}
+
+}  // namespace isohex::opt

@@ -1,0 +1,88 @@
+#pragma once
+/// \file local_energy.hpp
+/// \brief Internal to optimize/: the 9 frames of a hex, the per-frame energies and their
+/// derivatives, the energy of one vertex's neighbourhood, and one Newton move of a vertex.
+///
+/// Frame t of a hex is A_t = (1/L) Σ_k P_k c_{t,k}ᵀ with constant coefficient vectors c (so
+/// Σ_k c_{t,k} = 0: translation invariant). Moving one vertex P_k by d changes A_t by the rank-1
+/// term (1/L) d c_{t,k}ᵀ, hence det(A_t) is *affine* in d (matrix determinant lemma) and
+/// |A_t|² quadratic: the derivatives below are exact and cheap.
+
+#include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/optimize.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
+namespace isohex::opt {
+
+using Mat3 = Eigen::Matrix3d;
+
+/// Frames 0..7 are the corner frames (Verdict's kCornerNeighbors), 8 the centre frame.
+inline constexpr int kFrames = 9;
+inline constexpr int kCentreFrame = 8;
+
+/// Below this normalised determinant a frame counts as inverted in the feasibility tests of
+/// the shape stage: a safety gap so that Verdict's own rounding can never see a negative sign.
+inline constexpr double kMinFeasibleDet = 1e-10;
+
+/// Which energy a stage minimises.
+struct EnergyParams {
+  bool untangle = false;  ///< true: regularised energy (all 9 frames); false: inverse mean ratio (8 corners)
+  double eps = 0;         ///< untangle: the regularisation ε
+  double lambda = 0;      ///< untangle: weight of the volume term
+};
+
+/// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
+std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
+
+/// Frame t of corners p (already the hex's corners), scaled by inv_len.
+Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len);
+
+/// The coefficient c_{t,k} of corner k in frame t (zero when frame t does not use corner k).
+const Vec3& frame_coefficient(int t, int k);
+
+/// The energy of one hex under `params` (+inf if infeasible for the shape stage).
+double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params);
+
+/// True when all 9 frames of the hex have determinant > kMinFeasibleDet.
+bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len);
+
+/// The energy of the hexes around vertex v with v placed at x; with g and H, also its gradient
+/// and Hessian with respect to x (the Hessian of the regularised energy may be indefinite).
+/// +inf if the shape stage would make a hex infeasible.
+double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
+                     const Vec3& x, const EnergyParams& params, Vec3* g = nullptr, Mat3* H = nullptr);
+
+/// One Newton step of vertex v with a backtracking (Armijo) line search; returns the new
+/// position (the old one if no step lowered the energy) and the scaled gradient norm |g|·L.
+struct Move {
+  Vec3 x;
+  double grad = 0;
+  bool moved = false;
+};
+Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
+                 const EnergyParams& params);
+
+/// Σ of hex energies, computed in parallel per hex and summed in hex order (deterministic).
+/// `skip` (may be empty) leaves hexes out.
+double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, const EnergyParams& params,
+                    const std::vector<std::uint8_t>& skip = {});
+
+/// One Gauss–Seidel sweep: colours in order, the vertices of a colour in parallel, each taking
+/// `steps` Newton moves. Vertices with frozen[v] set do not move (frozen may be empty).
+/// Returns the largest scaled gradient norm seen.
+double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc, const std::vector<double>& inv_len,
+             const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps = 1);
+
+/// Minimum scaled Jacobian (Verdict; degenerate counts as -1) and the number of hexes <= 0.
+struct SJStats {
+  double min = 0;
+  std::size_t inverted = 0;
+};
+SJStats sj_stats(const HexMesh& mesh);
+
+}  // namespace isohex::opt

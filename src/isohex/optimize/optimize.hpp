@@ -1,0 +1,134 @@
+#pragma once
+/// \file optimize.hpp
+/// \brief Moving interior vertices of a hex mesh: untangling, mean-ratio shape optimisation
+/// and a worst-element pass, with chosen vertices held fixed.
+///
+/// All three stages are local: one vertex moves at a time, everything else frozen, and a move
+/// is kept only if it lowers that vertex's share of the objective (or, in the worst-element
+/// pass, raises the lowest scaled Jacobian around it). Vertices are graph-coloured so that no
+/// two vertices of a colour share a hex; colours are visited in order and the vertices of one
+/// colour in parallel (oneTBB). A vertex's move reads only vertices of other colours, so the
+/// result is bit-identical for any thread count.
+///
+/// Each hex contributes 9 frames (3×3 matrices A linear in its 8 corners): the 8 corner frames
+/// of Verdict's scaled Jacobian (kCornerNeighbors) and the centre frame (principal axes / 4),
+/// all measured in units of the hex's mean edge length at the start of a stage, so that a
+/// unit cube has A = I in every frame. A hex is valid (scaled Jacobian > 0) when all 9
+/// determinants are positive.
+///
+/// - untangle(): Garanzha et al. 2021 ("Foldover-free maps in 50 lines of code")-style
+///   regularised energy per frame, f = |A|²/(3 χ^{2/3}) + λ (D² + 1)/χ with
+///   χ(D, ε) = (D + sqrt(ε² + D²))/2, minimised by per-vertex Newton steps with backtracking,
+///   ε lowered between sweeps. It continues past "no inverted element" until the minimum
+///   scaled Jacobian reaches a margin, because a barrier objective must never be handed a mesh
+///   that is invalid by rounding (the failure observed with Mesquite on pave1 and ECR bust).
+/// - optimize_shape(): Knupp's inverse mean ratio |A|²/(3 det(A)^{2/3}) summed over the 8
+///   corner frames of each valid hex (ideal: the unit cube corner). A move must keep all 9
+///   determinants of every incident hex positive, so no valid hex is ever inverted, and it
+///   must lower the objective, so the objective never increases.
+/// - improve_worst(): local max–min moves on the vertices of the worst hexes, accepted only if
+///   the minimum scaled Jacobian (Verdict's) of the hexes around the vertex rises.
+
+#include "isohex/mesh/hex_mesh.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace isohex {
+
+/// Which vertices the optimisers hold fixed.
+enum class FixedVertices {
+  boundary,  ///< the vertices of boundary quads (default: the shape of the domain is kept)
+  file,      ///< the mesh's own `fixed` flags (e.g. a VTK `fixed` point array)
+  none,      ///< every vertex may move
+};
+
+/// The fixed-vertex mask (1 = fixed) for a choice; `file` with a mesh without flags fixes none.
+std::vector<std::uint8_t> fixed_mask(const HexMesh& mesh, FixedVertices which);
+
+/// A colouring of the free vertices: vertices of one colour share no hex.
+struct VertexColoring {
+  std::vector<std::vector<Index>> colors;  ///< free vertex ids per colour, ascending
+};
+/// Greedy colouring in vertex order (deterministic). Fixed vertices are left out.
+VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed);
+
+/// One line of progress.
+struct IterationReport {
+  std::string stage;        ///< "untangle", "shape" or "worst"
+  int iteration = 0;
+  double objective = 0;     ///< stage objective (shape: mean inverse mean ratio over corners)
+  double min_sj = 0;        ///< minimum scaled Jacobian (Verdict) of the mesh
+  std::size_t inverted = 0; ///< hexes with scaled Jacobian <= 0
+};
+using ProgressCallback = std::function<void(const IterationReport&)>;
+
+/// Options of the untangler.
+struct UntangleOptions {
+  double margin = 0.05;   ///< stop once the minimum scaled Jacobian reaches this
+  int max_iter = 200;     ///< outer iterations (ε updates)
+  int sweeps = 4;         ///< Gauss–Seidel sweeps per outer iteration
+  double lambda = 0.5;    ///< weight of the volume term (D² + 1)/χ
+  ProgressCallback progress;
+};
+
+/// What the untangler did.
+struct UntangleResult {
+  int iterations = 0;
+  double min_sj = 0;               ///< after
+  std::size_t inverted = 0;        ///< hexes with scaled Jacobian <= 0 after
+  bool reached_margin = false;
+  /// Hexes with an inverted corner frame whose 4 vertices are all fixed (e.g. an inverted hex
+  /// with all 8 vertices fixed): no move can repair them. When there are any, untangle()
+  /// reports them and leaves the mesh unchanged.
+  std::vector<Index> impossible;
+};
+
+/// Untangles `mesh` in place, vertices with fixed[v] != 0 untouched.
+UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const UntangleOptions& options = {});
+
+/// Options of the shape optimiser.
+struct ShapeOptions {
+  int max_iter = 100;        ///< Gauss–Seidel sweeps
+  double tol = 1e-5;         ///< stop when a sweep lowers the objective by less than tol (relative)
+  double grad_tol = 1e-8;    ///< ... or when the largest vertex gradient (× edge length) is below this
+  ProgressCallback progress;
+};
+
+/// What the shape optimiser did.
+struct ShapeResult {
+  int iterations = 0;
+  double objective_before = 0, objective_after = 0;  ///< mean corner inverse mean ratio (1 = cubes)
+  std::size_t frozen_hexes = 0;  ///< invalid hexes whose vertices were held (the barrier needs valid hexes)
+  std::vector<double> history;   ///< objective after each sweep
+};
+
+/// The shape objective: Σ over valid hexes and their 8 corners of |A|²/(3 det(A)^{2/3}), divided
+/// by the number of terms (1 for a mesh of cubes). Invalid hexes are left out.
+double shape_objective(const HexMesh& mesh);
+
+/// Lowers the inverse mean ratio in place; never inverts a valid hex, never raises the objective.
+ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const ShapeOptions& options = {});
+
+/// Options of the worst-element pass.
+struct WorstOptions {
+  double below = 1.5;     ///< work on the vertices of hexes with scaled Jacobian below this ...
+  std::size_t count = 100;  ///< ... at most this many of the worst
+  int passes = 10;
+  ProgressCallback progress;
+};
+
+/// What the worst-element pass did.
+struct WorstResult {
+  int passes = 0;
+  std::size_t moves = 0;
+  double min_sj_before = 0, min_sj_after = 0;
+};
+
+/// Raises the lowest scaled Jacobians in place; the mesh minimum never decreases.
+WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const WorstOptions& options = {});
+
+}  // namespace isohex

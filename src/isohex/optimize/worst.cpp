@@ -1,0 +1,119 @@
+// Worst-element pass: local max–min moves on Verdict's scaled Jacobian itself.
+#include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/optimize.hpp"
+#include "isohex/quality/hex_quality.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace isohex {
+
+namespace {
+
+// Degenerate (collapsed) hexes rank below every real value.
+double sj_value(const std::array<Vec3, 8>& p) {
+  const double v = scaled_jacobian(p);
+  return is_degenerate(v) ? -2.0 : v;
+}
+
+// The lowest scaled Jacobian of the hexes around v with v placed at x. With `valid`, also
+// whether every hex that is valid now (scaled Jacobian > 0) stays valid there.
+double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool* valid = nullptr) {
+  double lo = 2.0;
+  if (valid) *valid = true;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const Index h = inc.ids[i];
+    auto p = mesh.corners(h);
+    for (int k = 0; k < 8; ++k)
+      if (mesh.hexes[h][k] == v) p[k] = x;
+    const double q = sj_value(p);
+    lo = std::min(lo, q);
+    if (valid && q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
+  }
+  return lo;
+}
+
+double mean_edge(const HexMesh& mesh, const Incidence& inc, Index v) {
+  double sum = 0;
+  int n = 0;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+    for (const auto& e : kHexEdges) {
+      const Hex& hx = mesh.hexes[inc.ids[i]];
+      if (hx[e[0]] != v && hx[e[1]] != v) continue;
+      sum += (mesh.points[hx[e[0]]] - mesh.points[hx[e[1]]]).norm();
+      ++n;
+    }
+  return n ? sum / n : 0.0;
+}
+
+// One max–min move of v: a finite-difference ascent direction of the local minimum, then
+// shrinking steps; the first that raises the local minimum (inverting nothing) is taken.
+bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v) {
+  const Vec3 x0 = mesh.points[v];
+  const double m0 = local_min(mesh, inc, v, x0);
+  const double len = mean_edge(mesh, inc, v);
+  if (!(len > 0)) return false;
+  const double h = 1e-5 * len;
+  Vec3 g;
+  for (int j = 0; j < 3; ++j) {
+    Vec3 a = x0, b = x0;
+    a[j] += h;
+    b[j] -= h;
+    g[j] = (local_min(mesh, inc, v, a) - local_min(mesh, inc, v, b)) / (2 * h);
+  }
+  if (!(g.norm() > 0)) return false;
+  const Vec3 d = g.normalized() * len;
+  double t = 0.2;
+  for (int i = 0; i < 12; ++i, t *= 0.5) {
+    const Vec3 x = x0 + t * d;
+    bool valid = false;
+    // Raising the local minimum is not enough when it is negative: a valid neighbour must
+    // not be inverted on the way (it could still sit above that negative minimum).
+    if (local_min(mesh, inc, v, x, &valid) > m0 && valid) {
+      mesh.points[v] = x;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const WorstOptions& options) {
+  WorstResult res;
+  const Incidence inc = vertex_hexes(mesh);
+  std::vector<double> sj(mesh.hexes.size());
+  for (Index h = 0; h < mesh.num_hexes(); ++h) sj[h] = sj_value(mesh.corners(h));
+  const auto mesh_min = [&] { return sj.empty() ? 1.0 : *std::min_element(sj.begin(), sj.end()); };
+  res.min_sj_before = res.min_sj_after = mesh_min();
+  std::vector<Index> order(mesh.hexes.size());
+  std::vector<Index> seen(mesh.points.size(), -1);
+  for (int pass = 1; pass <= options.passes; ++pass) {
+    // Sequential and in a fixed order (worst first, ties by id): deterministic, and cheap
+    // since only a few hundred vertices take part.
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return sj[a] < sj[b]; });
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < order.size() && i < options.count && sj[order[i]] < options.below; ++i) {
+      for (Index v : mesh.hexes[order[i]]) {
+        if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
+        seen[v] = pass;
+        if (!move_vertex(mesh, inc, v)) continue;
+        ++moved;
+        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) sj[inc.ids[k]] = sj_value(mesh.corners(inc.ids[k]));
+      }
+    }
+    res.passes = pass;
+    res.moves += moved;
+    res.min_sj_after = mesh_min();
+    if (options.progress) {
+      std::size_t inverted = 0;
+      for (double x : sj) inverted += x <= 0;
+      options.progress({"worst", pass, static_cast<double>(moved), res.min_sj_after, inverted});
+    }
+    if (moved == 0) break;
+  }
+  return res;
+}
+
+}  // namespace isohex

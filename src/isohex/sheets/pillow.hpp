@@ -1,0 +1,97 @@
+#pragma once
+/// \file pillow.hpp
+/// \brief Sheet insertion by pillowing (Mitchell & Tautges 1995; Shepherd et al. 2006, §4.1.1).
+///
+/// A *shrink set* is a set of hexes. Its *interface* is the set of quads between a
+/// shrink-set hex and a hex outside it, plus — for the boundary variant — the boundary
+/// quads of shrink-set hexes. Pillowing splits every interface vertex, gives the copy to
+/// the shrink-set hexes, moves the copy a little into the shrink set, and fills the gap with
+/// one new hex per interface quad: a new dual sheet parallel to the interface.
+///
+/// \par Pinches
+/// Around an interface vertex v, the shrink-set hexes fall into fans: groups connected
+/// through shrink-set/shrink-set quads that contain v. Each fan gets its own copy of v,
+/// so that two shrink-set hexes touching only at an edge or a vertex are pillowed
+/// separately (the interface is not a disk there). The opposite pinch — one fan of the
+/// shrink set touching two separate regions outside it at v, i.e. the fan's interface quads
+/// around v falling apart into two pieces — has no valid placement for a single copy (it
+/// would have to move away from both regions at once) and is refused with an isohex::Error
+/// naming the vertex; add or remove a hex there.
+///
+/// \par Boundary
+/// Interface vertices on the mesh boundary whose fan still has boundary quads at v (the
+/// interface reaches the boundary there) keep their copy on the boundary: the copy moves in
+/// the boundary's tangent plane only, so the new sheet ends on the boundary. In the boundary
+/// variant the boundary quads are themselves interface quads, the original surface vertices
+/// stay where they are (only new hexes use them) and the copies go inward: the surface mesh
+/// is bit-identical before and after.
+///
+/// \par Placement
+/// The copy of v moves along the area-weighted mean normal of its fan's interface quads
+/// (pointing into the shrink set) by `offset` × the mean length of the fan's interface edges
+/// at v, lengthened by up to 2× at convex corners so that the new layer is `offset` thick
+/// measured normal to each quad (a vertex at a cube corner moves along the diagonal by
+/// √3·offset·h). Wherever a new hex or a changed shrink-set hex would have a scaled
+/// Jacobian ≤ 0, the displacements of the copies it uses are halved, repeatedly.
+
+#include "isohex/mesh/hex_mesh.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace isohex {
+
+/// How to pillow.
+struct PillowOptions {
+  /// Thickness of the new layer as a fraction of the local mean edge length. 0.25 leaves a
+  /// shrink-set hex at least half its thickness even where the interface covers two of its
+  /// opposite faces (a one-hex-thick shrink set), so halving is rarely needed, while the new
+  /// hexes stay within a 4:1 aspect ratio that smoothing can relax afterwards.
+  double offset = 0.25;
+  /// Also pillow the boundary quads of shrink-set hexes (the sheet then encloses the shrink
+  /// set instead of ending on the boundary).
+  bool include_boundary = false;
+  /// Halvings of a displacement tried before giving up on a vertex.
+  int max_halvings = 24;
+};
+
+/// What pillow() did.
+struct PillowResult {
+  HexMesh mesh;                     ///< the pillowed mesh: old vertices and hexes keep their ids
+  std::size_t interface_quads = 0;  ///< = new hexes, appended after the old ones
+  std::size_t interface_vertices = 0;
+  std::size_t pinch_copies = 0;     ///< copies beyond one per interface vertex (pinched fans)
+  std::size_t reduced_vertices = 0; ///< copies whose displacement had to be halved
+  double min_new_scaled_jacobian = 1.0;  ///< over the new hexes
+  /// Vertex that each new vertex copies: mesh.points[old_num_vertices + i] is a copy of
+  /// copy_of[i].
+  std::vector<Index> copy_of;
+};
+
+/// Pillows `shrink_set` (one flag per hex, nonzero = in the set) of a valid mesh.
+/// Throws isohex::Error if the mesh is invalid, the set is empty or has no interface, the
+/// flags do not match the hexes, or a copy cannot be placed (see the file comment).
+PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink_set,
+                    const PillowOptions& options = {});
+
+/// Boundary sheets (§4.1.1): pillows the whole mesh (block < 0) or the hexes of one block,
+/// boundary quads included, so that every boundary component is captured by one new sheet.
+PillowResult pillow_boundary(const HexMesh& mesh, Index block = -1, double offset = PillowOptions{}.offset);
+
+/// A shrink set from a CLI specification: `boundary` (every hex), `block:ID`,
+/// `region:EXPR` (hexes whose centroid is inside the implicit shape EXPR, see implicit.hpp)
+/// or `ids:FILE` (one hex id per line; blank lines and lines starting with '#' ignored).
+/// Throws isohex::Error for an unknown kind, a bad id (naming the file and line) or a bad
+/// shape expression.
+std::vector<std::uint8_t> shrink_set_from_spec(const HexMesh& mesh, const std::string& spec);
+
+/// True for specs whose sheet should enclose the set, boundary quads included
+/// (`boundary`, `block:ID`).
+bool spec_includes_boundary(const std::string& spec);
+
+/// Number of hexes with two or more faces on the boundary (each such hex has a boundary
+/// edge with a dihedral angle set by one element: the poor-quality situation §3.2 avoids).
+std::size_t count_multi_boundary_hexes(const HexMesh& mesh);
+
+}  // namespace isohex

@@ -1,0 +1,167 @@
+// Shape optimisation: derivatives, colouring, the guarantees of each stage, determinism.
+#include "isohex/mesh/generate.hpp"
+#include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/local_energy.hpp"
+#include "isohex/optimize/optimize.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <numeric>
+#include <set>
+
+using namespace isohex;
+
+namespace {
+
+// A jittered box (boundary vertices too, so that cubes are out of reach) whose boundary
+// vertices are then flagged fixed.
+HexMesh jittered_box(int n, double amplitude, unsigned seed) {
+  HexMesh m = box_mesh(n, n, n);
+  jitter(m, amplitude / n, seed);
+  m.fixed = boundary_vertex_mask(m);
+  return m;
+}
+
+double min_sj(const HexMesh& m) {
+  double lo = 1e300;
+  for (double v : scaled_jacobians(m)) lo = std::min(lo, is_degenerate(v) ? -1.0 : v);
+  return lo;
+}
+
+// Checks the analytic gradient and Hessian of vertex_energy against central differences.
+void check_derivatives(const HexMesh& m, Index v, const opt::EnergyParams& p) {
+  const Incidence inc = vertex_hexes(m);
+  const std::vector<double> il = opt::inverse_edge_lengths(m);
+  Vec3 g;
+  opt::Mat3 H;
+  const Vec3 x = m.points[v];
+  ASSERT_TRUE(std::isfinite(opt::vertex_energy(m, inc, il, v, x, p, &g, &H)));
+  const double h = 1e-5;
+  for (int j = 0; j < 3; ++j) {
+    Vec3 a = x, b = x;
+    a[j] += h;
+    b[j] -= h;
+    Vec3 ga, gb;
+    const double fd = (opt::vertex_energy(m, inc, il, v, a, p, &ga) - opt::vertex_energy(m, inc, il, v, b, p, &gb)) / (2 * h);
+    EXPECT_NEAR(g[j], fd, 1e-5 * (1 + std::abs(fd)));
+    const Vec3 hcol = (ga - gb) / (2 * h);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(H(i, j), hcol[i], 1e-4 * (1 + H.cwiseAbs().maxCoeff()));
+  }
+}
+
+}  // namespace
+
+TEST(OptimizeShape, DerivativesMatchFiniteDifferences) {
+  HexMesh m = jittered_box(3, 0.3, 7);
+  const Index v = 1 + 4 + 16;  // an interior vertex of the 4×4×4 vertex grid
+  ASSERT_EQ(m.fixed[v], 0);
+  check_derivatives(m, v, opt::EnergyParams{});
+  check_derivatives(m, v, opt::EnergyParams{true, 0.3, 0.5});
+  // Inverted neighbourhood: the regularised energy stays smooth there.
+  m.points[v] += Vec3(0.5, 0.4, 0.3);
+  check_derivatives(m, v, opt::EnergyParams{true, 0.05, 0.5});
+}
+
+TEST(OptimizeShape, ColoringSeparatesVerticesOfEachHex) {
+  HexMesh m = jittered_box(4, 0.2, 3);
+  const VertexColoring c = color_vertices(m, m.fixed);
+  std::vector<int> color(m.points.size(), -1);
+  std::size_t free = 0;
+  for (std::uint8_t f : m.fixed) free += f == 0;
+  std::size_t total = 0;
+  for (std::size_t k = 0; k < c.colors.size(); ++k)
+    for (Index v : c.colors[k]) {
+      EXPECT_EQ(m.fixed[v], 0);
+      color[v] = static_cast<int>(k);
+      ++total;
+    }
+  EXPECT_EQ(total, free);
+  for (const Hex& h : m.hexes) {
+    std::set<int> seen;
+    for (Index v : h)
+      if (color[v] >= 0) EXPECT_TRUE(seen.insert(color[v]).second);
+  }
+}
+
+TEST(OptimizeShape, UnitGridIsOptimal) {
+  HexMesh m = box_mesh(3, 3, 3);
+  EXPECT_NEAR(shape_objective(m), 1.0, 1e-12);
+  const HexMesh before = m;
+  const ShapeResult r = optimize_shape(m, fixed_mask(m, FixedVertices::boundary));
+  EXPECT_NEAR(r.objective_after, 1.0, 1e-12);
+  for (std::size_t i = 0; i < m.points.size(); ++i) EXPECT_LT((m.points[i] - before.points[i]).norm(), 1e-9);
+}
+
+TEST(OptimizeShape, JitteredGridsStayValidAndImprove) {
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    HexMesh m = jittered_box(5, 0.25, seed);
+    const std::vector<double> sj0 = scaled_jacobians(m);
+    ASSERT_GT(min_sj(m), 0) << "seed " << seed << ": the test wants a valid start";
+    const HexMesh before = m;
+    const ShapeResult r = optimize_shape(m, m.fixed);
+    EXPECT_LT(r.objective_after, r.objective_before);
+    double prev = r.objective_before;
+    for (double e : r.history) {
+      EXPECT_LE(e, prev);  // never increases, sweep after sweep
+      prev = e;
+    }
+    EXPECT_GT(min_sj(m), 0) << "seed " << seed;
+    for (std::size_t i = 0; i < m.points.size(); ++i)
+      if (m.fixed[i]) EXPECT_EQ(m.points[i], before.points[i]);  // bit-identical
+    const double mean_before = std::accumulate(sj0.begin(), sj0.end(), 0.0) / sj0.size();
+    const std::vector<double> sj1 = scaled_jacobians(m);
+    EXPECT_GT(std::accumulate(sj1.begin(), sj1.end(), 0.0) / sj1.size(), mean_before);
+  }
+}
+
+TEST(OptimizeShape, InvalidHexesAreHeldAndOthersStayValid) {
+  HexMesh m = jittered_box(4, 0.2, 5);
+  const Index v = 1 + 5 + 25;  // interior vertex; push it far to invert its hexes
+  m.points[v] += Vec3(0.4, 0.4, 0.4);
+  const std::vector<double> sj0 = scaled_jacobians(m);
+  const HexMesh before = m;
+  const ShapeResult r = optimize_shape(m, m.fixed);
+  EXPECT_GT(r.frozen_hexes, 0u);
+  const std::vector<double> sj1 = scaled_jacobians(m);
+  for (std::size_t h = 0; h < sj0.size(); ++h) {
+    if (sj0[h] > 0) EXPECT_GT(sj1[h], 0) << h;
+    else EXPECT_EQ(sj1[h], sj0[h]) << h;  // invalid hexes untouched
+  }
+  EXPECT_EQ(m.points[v], before.points[v]);
+}
+
+TEST(OptimizeShape, WorstPassNeverLowersTheMinimum) {
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    HexMesh m = jittered_box(5, 0.25, seed);
+    optimize_shape(m, m.fixed);
+    const double lo = min_sj(m);
+    const HexMesh before = m;
+    const WorstResult w = improve_worst(m, m.fixed, WorstOptions{0.9, 50, 5, {}});
+    EXPECT_GE(min_sj(m), lo);
+    EXPECT_EQ(w.min_sj_before, lo);
+    EXPECT_EQ(w.min_sj_after, min_sj(m));
+    EXPECT_GT(w.moves, 0u);
+    for (std::size_t i = 0; i < m.points.size(); ++i)
+      if (m.fixed[i]) EXPECT_EQ(m.points[i], before.points[i]);
+  }
+}
+
+TEST(OptimizeShape, SameBitsForOneAndTwoThreads) {
+  auto run = [](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+    HexMesh m = jittered_box(6, 0.7, 11);  // tangled: every stage does work
+    UntangleOptions uo;
+    uo.max_iter = 20;
+    untangle(m, m.fixed, uo);
+    optimize_shape(m, m.fixed);
+    improve_worst(m, m.fixed);
+    return m.points;
+  };
+  const auto one = run(1), two = run(2);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t i = 0; i < one.size(); ++i) ASSERT_EQ(one[i], two[i]) << i;
+}

@@ -1,0 +1,249 @@
+// Pillowing: counts, validity, pinches, the boundary, errors, on generated grids.
+#include "isohex/error.hpp"
+#include "isohex/mesh/generate.hpp"
+#include "isohex/mesh/topology.hpp"
+#include "isohex/mesh/validate.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "sheets_support.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace isohex::test {
+
+PillowResult checked_pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& set, const PillowOptions& opt) {
+  PillowResult r = pillow(mesh, set, opt);
+  const HexMesh& m = r.mesh;
+  EXPECT_EQ(m.hexes.size(), mesh.hexes.size() + r.interface_quads);
+  EXPECT_EQ(m.points.size(), mesh.points.size() + r.interface_vertices + r.pinch_copies);
+  EXPECT_EQ(r.copy_of.size(), r.interface_vertices + r.pinch_copies);
+  const ValidationReport v = validate(m);
+  EXPECT_TRUE(v.valid()) << (v.faults.empty() ? "" : v.faults.front().message);
+  EXPECT_EQ(v.num_boundary_components, validate(mesh).num_boundary_components);
+  for (std::size_t i = 0; i < mesh.points.size(); ++i) EXPECT_EQ(m.points[i], mesh.points[i]);
+  const auto before = scaled_jacobians(mesh), after = scaled_jacobians(m);
+  for (std::size_t h = 0; h < mesh.hexes.size(); ++h) {
+    if (set[h] == 0) {
+      EXPECT_EQ(m.hexes[h], mesh.hexes[h]) << "hex " << h << " outside the shrink set changed";
+    } else if (before[h] > 0 && !is_degenerate(before[h])) {
+      EXPECT_GT(after[h], 0) << "shrink-set hex " << h;
+      EXPECT_FALSE(is_degenerate(after[h])) << "shrink-set hex " << h;
+    }
+    for (int k = 0; k < 8; ++k) {  // a shrink-set hex uses the originals or their copies
+      const Index x = m.hexes[h][k];
+      EXPECT_EQ(x < mesh.num_vertices() ? x : r.copy_of[x - mesh.num_vertices()], mesh.hexes[h][k]);
+    }
+  }
+  for (std::size_t h = mesh.hexes.size(); h < m.hexes.size(); ++h) {
+    EXPECT_GT(after[h], 0) << "new hex " << h;
+    EXPECT_FALSE(is_degenerate(after[h])) << "new hex " << h;
+    EXPECT_GE(after[h], r.min_new_scaled_jacobian);
+  }
+  return r;
+}
+
+bool same_surface(const HexMesh& a, const HexMesh& b) {
+  auto key = [](const HexMesh& m) {
+    std::vector<std::array<Index, 4>> qs = boundary_quads(m);
+    for (auto& q : qs) std::rotate(q.begin(), std::min_element(q.begin(), q.end()), q.end());
+    std::sort(qs.begin(), qs.end());
+    return qs;
+  };
+  const auto qa = key(a), qb = key(b);
+  if (qa != qb) return false;
+  for (const auto& q : qa)
+    for (Index v : q)
+      if (a.points[v] != b.points[v]) return false;
+  return true;
+}
+
+namespace {
+
+std::vector<std::uint8_t> only(const HexMesh& m, std::initializer_list<Index> hexes) {
+  std::vector<std::uint8_t> s(m.hexes.size(), 0);
+  for (Index h : hexes) s[h] = 1;
+  return s;
+}
+
+Index cell(int i, int j, int k, int nx, int ny) { return i + nx * (j + ny * k); }
+
+TEST(Pillow, OneInteriorHexGetsSixNewHexesAndEightCopies) {
+  const HexMesh m = grid_mesh(3, 3, 3);
+  const PillowResult r = checked_pillow(m, only(m, {cell(1, 1, 1, 3, 3)}));
+  EXPECT_EQ(r.interface_quads, 6u);
+  EXPECT_EQ(r.interface_vertices, 8u);
+  EXPECT_EQ(r.pinch_copies, 0u);
+  EXPECT_EQ(r.reduced_vertices, 0u);
+  // A cube corner moves along the diagonal so that each face moves inward by offset × h.
+  const Vec3 c = r.mesh.points[m.num_vertices()];
+  const Vec3 o = m.points[r.copy_of[0]];
+  EXPECT_NEAR((c - o).cwiseAbs().maxCoeff(), 0.25, 1e-12);
+  // Frusta 1 × 1 below, 0.5 × 0.5 above, 0.25 high: the worst corner is a cube corner's
+  // diagonal against two edges, 1/√3.
+  EXPECT_NEAR(r.min_new_scaled_jacobian, 1 / std::sqrt(3.0), 1e-12);
+}
+
+TEST(Pillow, TwoHexesTouchingAtAnEdgeArePillowedSeparately) {
+  const HexMesh m = grid_mesh(4, 4, 3);
+  const PillowResult r = checked_pillow(m, only(m, {cell(1, 1, 1, 4, 4), cell(2, 2, 1, 4, 4)}));
+  EXPECT_EQ(r.interface_quads, 12u);
+  EXPECT_EQ(r.interface_vertices, 14u);
+  EXPECT_EQ(r.pinch_copies, 2u);  // the two ends of the shared edge
+}
+
+TEST(Pillow, TwoHexesTouchingAtAVertexArePillowedSeparately) {
+  const HexMesh m = grid_mesh(4, 4, 4);
+  const PillowResult r = checked_pillow(m, only(m, {cell(1, 1, 1, 4, 4), cell(2, 2, 2, 4, 4)}));
+  EXPECT_EQ(r.interface_quads, 12u);
+  EXPECT_EQ(r.interface_vertices, 15u);
+  EXPECT_EQ(r.pinch_copies, 1u);
+}
+
+TEST(Pillow, SeveralComponentsAndAPlanarSheetEndingOnTheBoundary) {
+  const HexMesh m = grid_mesh(4, 4, 4);
+  std::vector<std::uint8_t> half(m.hexes.size(), 0);
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 2; ++i) half[cell(i, j, k, 4, 4)] = 1;
+  const PillowResult r = checked_pillow(m, half);
+  EXPECT_EQ(r.interface_quads, 16u);
+  EXPECT_EQ(r.interface_vertices, 25u);
+  // The copies stay on the box faces they started on: the new sheet ends on the boundary.
+  for (std::size_t c = 0; c < r.copy_of.size(); ++c) {
+    const Vec3& o = m.points[r.copy_of[c]];
+    const Vec3& p = r.mesh.points[m.num_vertices() + c];
+    EXPECT_DOUBLE_EQ(p.x(), 1.75);
+    for (int a = 1; a < 3; ++a)
+      if (o[a] == 0 || o[a] == 4) EXPECT_NEAR(p[a], o[a], 1e-12);
+  }
+  EXPECT_EQ(validate(r.mesh).num_boundary_quads, validate(m).num_boundary_quads + 16);
+
+  auto two = only(m, {cell(0, 0, 0, 4, 4), cell(3, 3, 3, 4, 4), cell(2, 1, 1, 4, 4)});
+  const PillowResult r2 = checked_pillow(m, two);
+  EXPECT_EQ(r2.interface_quads, 3u + 3u + 6u);
+  EXPECT_EQ(r2.pinch_copies, 0u);
+}
+
+TEST(Pillow, OuterPinchIsRefusedWithTheVertex) {
+  // Shrink set = all but two hexes touching at one vertex: the shrink set's single fan there
+  // touches two separate outside regions.
+  const HexMesh m = grid_mesh(2, 2, 2);
+  std::vector<std::uint8_t> s(8, 1);
+  s[0] = s[7] = 0;
+  try {
+    pillow(m, s);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("pinched on the outside at vertex 13"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Pillow, FanThatCannotSeeAllItsInterfaceIsRefused) {
+  // Around the centre of a 2³ grid: five shrink-set octants forming one fan around three
+  // outside octants that touch each other only at the centre. The fan's interface is one
+  // piece, but no direction leaves the centre into all five octants' interface corners.
+  const HexMesh m = grid_mesh(2, 2, 2);
+  std::vector<std::uint8_t> s = {1, 0, 1, 1, 0, 1, 0, 1};
+  try {
+    pillow(m, s);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("pinched or folded at vertex 13"), std::string::npos) << e.what();
+  }
+}
+
+/// Random connected-ish shrink sets on jittered grids: every pillow either succeeds with all
+/// the checks of checked_pillow or refuses an outer pinch.
+TEST(Pillow, RandomShrinkSetsOnJitteredGrids) {
+  std::mt19937 rng(7);
+  int ok = 0, refused = 0, pinched = 0;
+  for (int trial = 0; trial < 120; ++trial) {
+    const int nx = 3 + trial % 3, ny = 3 + trial % 2, nz = 3;
+    HexMesh m = grid_mesh(nx, ny, nz);
+    jitter(m, 0.12, static_cast<unsigned>(trial + 1));
+    std::vector<std::uint8_t> s(m.hexes.size(), 0);
+    const double p = std::uniform_real_distribution<double>(0.1, 0.6)(rng);
+    for (auto& f : s) f = std::bernoulli_distribution(p)(rng);
+    if (std::count(s.begin(), s.end(), 1) == 0) s[0] = 1;
+    if (std::count(s.begin(), s.end(), 1) == static_cast<long>(s.size())) s[0] = 0;
+    PillowOptions opt;
+    opt.include_boundary = trial % 2 == 1;
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    try {
+      const PillowResult r = checked_pillow(m, s, opt);
+      ++ok;
+      pinched += r.pinch_copies > 0;
+    } catch (const Error& e) {
+      // Only an outer pinch (or a fold, which a jittered grid cannot have) may be refused.
+      EXPECT_NE(std::string(e.what()).find("pinched"), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GE(ok, 40) << refused << " refused";
+  EXPECT_GE(pinched, 10);
+}
+
+TEST(Pillow, BoundarySheetsKeepTheSurfaceBitIdentical) {
+  HexMesh cavity = grid_mesh(5, 5, 5);
+  cavity.hexes.erase(cavity.hexes.begin() + cell(2, 2, 2, 5, 5));
+  HexMesh jittered = box_mesh(3, 4, 5, Vec3(-1, 0, 2), Vec3(0.5, 1, 3));
+  jitter(jittered, 0.02, 3);
+  for (const HexMesh* m : {&jittered, &cavity}) {
+    const std::size_t bq = validate(*m).num_boundary_quads, bv = validate(*m).num_boundary_vertices;
+    const PillowResult r = checked_pillow(*m, std::vector<std::uint8_t>(m->hexes.size(), 1), {.include_boundary = true});
+    EXPECT_EQ(r.interface_quads, bq);
+    EXPECT_EQ(r.interface_vertices, bv);
+    EXPECT_TRUE(same_surface(*m, r.mesh));
+    EXPECT_GT(count_multi_boundary_hexes(*m), 0u);
+    EXPECT_EQ(count_multi_boundary_hexes(r.mesh), 0u);
+  }
+  const HexMesh ball = ball_mesh(6);
+  const PillowResult r = pillow_boundary(ball);
+  EXPECT_TRUE(same_surface(ball, r.mesh));
+  EXPECT_TRUE(validate(r.mesh).valid());
+  EXPECT_GT(r.min_new_scaled_jacobian, 0);
+  EXPECT_EQ(count_multi_boundary_hexes(r.mesh), 0u);
+}
+
+TEST(Pillow, OneBlockGetsAnEnclosingSheet) {
+  HexMesh m = grid_mesh(4, 3, 3);
+  m.blocks.assign(m.hexes.size(), 0);
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) m.blocks[cell(3, j, k, 4, 3)] = 5;
+  m.fixed.assign(m.points.size(), 1);
+  const PillowResult r = pillow_boundary(m, 5);
+  EXPECT_EQ(r.interface_quads, 9u + 9u + 3u * 4u);  // the x = 3 face, the outer x face, 4 sides
+  EXPECT_TRUE(same_surface(m, r.mesh));
+  EXPECT_TRUE(validate(r.mesh).valid());
+  ASSERT_EQ(r.mesh.blocks.size(), r.mesh.hexes.size());
+  for (std::size_t h = m.hexes.size(); h < r.mesh.hexes.size(); ++h) EXPECT_EQ(r.mesh.blocks[h], 5);
+  ASSERT_EQ(r.mesh.fixed.size(), r.mesh.points.size());
+  EXPECT_EQ(r.mesh.fixed.back(), 0);  // copies are free to move
+  EXPECT_THROW(pillow_boundary(m, 9), Error);
+}
+
+TEST(Pillow, BadInputIsRefusedWithAClearMessage) {
+  const HexMesh m = grid_mesh(2, 2, 2);
+  auto message = [](auto&& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([&] { pillow(m, std::vector<std::uint8_t>(8, 0)); }).find("empty"), std::string::npos);
+  EXPECT_NE(message([&] { pillow(m, std::vector<std::uint8_t>(8, 1)); }).find("no interface"), std::string::npos);
+  EXPECT_NE(message([&] { pillow(m, std::vector<std::uint8_t>(3, 1)); }).find("3 flags"), std::string::npos);
+  EXPECT_NE(message([&] { pillow(m, only(m, {0}), {.offset = 1.5}); }).find("offset"), std::string::npos);
+  HexMesh bad = m;
+  bad.hexes[1][0] = bad.hexes[1][1];  // repeated vertex
+  EXPECT_NE(message([&] { pillow(bad, only(bad, {0})); }).find("input mesh is invalid"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace isohex::test
