@@ -189,8 +189,8 @@ void run(const Args& a) {
 
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
              out.mesh.num_hexes(), out.mesh.num_vertices(), r.surface_vertices, r.box_vertices, check.num_boundary_quads);
-  fmt::print("  manifold repair: {} points made inside in {} rounds; {} cells split\n", r.filled_points,
-             r.repair_rounds, r.split_cells);
+  fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds; {} cells split\n",
+             r.carved_points, r.filled_points, r.repair_rounds, r.split_cells);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -222,6 +222,7 @@ void run(const Args& a) {
     j["euler_characteristic"] = check.euler_characteristic;
     j["valid"] = check.valid();
     j["filled_points"] = r.filled_points;
+    j["carved_points"] = r.carved_points;
     j["split_cells"] = r.split_cells;
     j["dropped_components"] = r.dropped_components;
     j["dropped_hexes"] = r.dropped_hexes;

@@ -123,10 +123,11 @@ TEST(ContourManifold, CavitiesTouchingAtAVertexAreRepaired) {
   EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 1);
 }
 
-TEST(ContourManifold, CavitiesTouchingAlongAnEdgeAreRepaired) {
-  // Marching cubes joins these two cavities through the edge; with one dual vertex per inside
-  // component the cell above the edge would pinch, so the repair fills one cavity. The
-  // counts agree with marching cubes (one cavity), the cavity's volume does not.
+TEST(ContourManifold, CavitiesTouchingAlongAnEdgeAreJoined) {
+  // Marching cubes joins these two cavities through the edge (the inside corners of the
+  // ambiguous face are kept apart); with one dual vertex per inside component the cell above
+  // the edge would pinch, so the repair carves one inside point of that face, joining them
+  // into one L-shaped cavity as marching cubes does. Nothing is filled.
   std::vector<std::array<Index, 3>> in;
   for (Index z = 1; z < 7; ++z)
     for (Index y = 1; y < 7; ++y)
@@ -134,9 +135,66 @@ TEST(ContourManifold, CavitiesTouchingAlongAnEdgeAreRepaired) {
         if (!(x == 3 && y == 3 && z == 3) && !(x == 4 && y == 4 && z == 3)) in.push_back({x, y, z});
   const Meshed m = mesh_of(voxels(8, in));
   expect_closed_manifold(m);
-  EXPECT_EQ(m.result.report.filled_points, 1u);
+  EXPECT_EQ(m.result.report.carved_points, 1u);
+  EXPECT_EQ(m.result.report.filled_points, 0u);
+  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 3);
   EXPECT_EQ(m.check.num_boundary_components, 2u);
   EXPECT_EQ(m.check.euler_characteristic, 4);
+}
+
+TEST(ContourManifold, CarveTakesTheWeakerInsidePoint) {
+  // As above, but of the two inside points on the ambiguous face, (3, 4, 3) is nearer the
+  // isosurface: it is the one carved.
+  Volume v = voxels(8, {});
+  for (Index z = 1; z < 7; ++z)
+    for (Index y = 1; y < 7; ++y)
+      for (Index x = 1; x < 7; ++x)
+        if (!(x == 3 && y == 3 && z == 3) && !(x == 4 && y == 4 && z == 3)) v.at(x, y, z) = 1.0f;
+  v.at(3, 4, 3) = 0.6f;
+  const Meshed m = mesh_of(v);
+  expect_closed_manifold(m);
+  EXPECT_EQ(m.result.report.carved_points, 1u);
+  // Hexes are numbered in grid order: point (3, 4, 3) is gone, (4, 3, 3) is not. Their hex
+  // centroids (mean of corners) lie within half a cell of the point.
+  bool has_433 = false, has_343 = false;
+  for (Index h = 0; h < m.result.mesh.num_hexes(); ++h) {
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& p : m.result.mesh.corners(h)) c += p / 8;
+    has_433 |= (c - Vec3(4, 3, 3)).norm() < 0.5;
+    has_343 |= (c - Vec3(3, 4, 3)).norm() < 0.5;
+  }
+  EXPECT_TRUE(has_433);
+  EXPECT_FALSE(has_343);
+}
+
+TEST(ContourManifold, CarvingNeverCutsARod) {
+  // A one-point-thick rod bent round an outside point: in the cell at (1..2, 1..2, 1..2) the
+  // rod's points (2, 1, 1) and (1, 2, 1) sit on one face's diagonal, the outside points
+  // (1, 1, 1) and (2, 2, 1) on the other, and the rod joins them through the cell: an edge
+  // contact. Both carve candidates are rod points whose removal would cut the rod in two, so
+  // nothing is carved; the fill makes (2, 2, 1) inside and the rod stays one piece.
+  const std::vector<std::array<Index, 3>> rod = {{3, 1, 1}, {2, 1, 1}, {2, 1, 2}, {2, 2, 2},
+                                                 {1, 2, 2}, {1, 2, 1}, {1, 3, 1}};
+  const Meshed m = mesh_of(voxels(6, rod));
+  expect_closed_manifold(m);
+  EXPECT_EQ(m.result.report.carved_points, 0u);
+  EXPECT_EQ(m.result.report.filled_points, 1u);
+  EXPECT_EQ(m.result.mesh.num_hexes(), 8);
+  EXPECT_EQ(m.check.num_boundary_components, 1u);
+  EXPECT_EQ(m.check.euler_characteristic, 2);
+}
+
+TEST(ContourManifold, CarvingShortensARodEnd) {
+  // The same bend without the rod's two end points: now (2, 1, 1) and (1, 2, 1) are ends, and
+  // carving an end changes no topology, so the repair carves one of them and fills nothing.
+  const std::vector<std::array<Index, 3>> rod = {{2, 1, 1}, {2, 1, 2}, {2, 2, 2}, {1, 2, 2}, {1, 2, 1}};
+  const Meshed m = mesh_of(voxels(6, rod));
+  expect_closed_manifold(m);
+  EXPECT_EQ(m.result.report.carved_points, 1u);
+  EXPECT_EQ(m.result.report.filled_points, 0u);
+  EXPECT_EQ(m.result.mesh.num_hexes(), 4);
+  EXPECT_EQ(m.check.num_boundary_components, 1u);
+  EXPECT_EQ(m.check.euler_characteristic, 2);
 }
 
 TEST(ContourManifold, CheckerboardGivesSeparateCubes) {

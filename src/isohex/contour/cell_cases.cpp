@@ -86,4 +86,51 @@ std::uint8_t manifold_fill(std::uint8_t mask, std::uint8_t fixed_outside) {
   return static_cast<std::uint8_t>(fill & ~fixed_outside);
 }
 
+namespace {
+
+// Calls f(a, b) for each pair of corners in different parts of a non-manifold component's
+// complement that lie on a common face diagonal.
+template <typename F>
+void for_edge_contacts(std::uint8_t mask, F&& f) {
+  std::array<std::uint8_t, 8> comps{};
+  const int n = parts_of(mask, comps);
+  for (int k = 0; k < n; ++k) {
+    std::array<std::uint8_t, 8> rest{};
+    const int r = parts_of(static_cast<std::uint8_t>(~comps[k]), rest);
+    for (int x = 0; x < r; ++x)
+      for (int y = x + 1; y < r; ++y)
+        for (int a = 0; a < 8; ++a)
+          for (int b = 0; b < 8; ++b)
+            if ((rest[x] >> a & 1) && (rest[y] >> b & 1) && std::popcount(static_cast<unsigned>(a ^ b)) == 2) f(a, b);
+  }
+}
+
+}  // namespace
+
+bool has_edge_contact(std::uint8_t mask) {
+  if (cell_case(mask).manifold) return false;
+  bool found = false;
+  for_edge_contacts(mask, [&](int, int) { found = true; });
+  return found;
+}
+
+std::uint8_t carve_candidates(std::uint8_t mask) {
+  if (cell_case(mask).manifold) return 0;
+  std::uint8_t out = 0;
+  for_edge_contacts(mask, [&](int a, int b) {
+    // The face's other diagonal: both corners are inside (an outside one would join a and b).
+    const int d = a ^ b;
+    out |= static_cast<std::uint8_t>(1u << (a ^ (d & -d)) | 1u << (a ^ (d & (d - 1))));
+  });
+  return static_cast<std::uint8_t>(out & mask);
+}
+
+std::uint8_t manifold_carve(std::uint8_t mask, const float level[8], std::uint8_t allowed) {
+  const std::uint8_t cand = static_cast<std::uint8_t>(carve_candidates(mask) & allowed);
+  int best = -1;
+  for (int c = 0; c < 8; ++c)
+    if ((cand >> c & 1) && (best < 0 || level[c] < level[best])) best = c;
+  return best < 0 ? std::uint8_t{0} : static_cast<std::uint8_t>(1u << best);
+}
+
 }  // namespace isohex::contour

@@ -18,10 +18,15 @@
 ///
 /// Splitting cannot fix the complementary fault: an inside component whose complement in the
 /// cell falls apart (e.g. 6 inside corners around two opposite outside corners). The surface
-/// around its one vertex would be two cones meeting at a point. Such cells are *non-manifold*;
-/// the mesher makes the smaller outside parts inside (manifold_fill) until none is left.
-/// This is the one place the mesh's topology can differ from marching cubes (which keeps the
-/// two outside parts apart).
+/// around its one vertex would be two cones meeting at a point. Such cells are *non-manifold*
+/// and the mesher edits the samples, choosing the edit that keeps marching cubes' topology:
+///  - outside parts touching *along an edge* (two outside corners on a face diagonal):
+///    marching cubes joins them across that face (inside corners on an ambiguous face are
+///    kept apart), so one inside corner of that face is made outside (manifold_carve), which
+///    joins them the same way;
+///  - outside parts touching only *at a vertex* (body diagonal): marching cubes keeps them
+///    apart, so the smaller part is made inside (manifold_fill).
+/// These are the places the mesh's topology can still differ from marching cubes.
 
 #include <array>
 #include <cstdint>
@@ -45,5 +50,19 @@ const CellCase& cell_case(std::uint8_t mask);
 /// e.g. beyond the volume's box), else the largest (ties: the lowest corner). 0 when `mask`
 /// is manifold. Never returns a corner of `fixed_outside`.
 std::uint8_t manifold_fill(std::uint8_t mask, std::uint8_t fixed_outside);
+
+/// True when two parts of a non-manifold component's complement touch along an edge (have
+/// corners on a common face diagonal), the contact manifold_carve removes.
+bool has_edge_contact(std::uint8_t mask);
+
+/// The inside corner to make outside so that two outside parts touching along an edge join
+/// across their face, as marching cubes joins them: of the inside corners on the other
+/// diagonal of such faces, the one with the lowest `level` (nearest the isosurface, so the
+/// joint opens where the field is weakest; ties: the lowest corner). 0 when `mask` has no
+/// edge contact or no candidate is in `allowed`. `level[c]` is the level of inside corner c.
+std::uint8_t manifold_carve(std::uint8_t mask, const float level[8], std::uint8_t allowed = 0xff);
+
+/// The inside corners manifold_carve chooses from (0 when `mask` has no edge contact).
+std::uint8_t carve_candidates(std::uint8_t mask);
 
 }  // namespace isohex::contour

@@ -268,7 +268,10 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   rep.time_sample = seconds_since(t);
 
   t = stage("manifold repair");
-  rep.filled_points = repair_manifold(g, &rep.repair_rounds);
+  const RepairCounts repaired = repair_manifold(g);
+  rep.filled_points = repaired.filled;
+  rep.carved_points = repaired.carved;
+  rep.repair_rounds = repaired.rounds;
   rep.time_repair = seconds_since(t);
 
   if (options.min_component > 1) {

@@ -21,8 +21,10 @@
 /// apart and not held to the on-surface check, since the box face, not the isosurface, is
 /// the boundary there.
 ///
-/// Before vertices are placed, non-manifold cells are repaired by making outside points
-/// inside (cell_cases.hpp), repeated until none is left; this only adds points, so it ends.
+/// Before vertices are placed, non-manifold cells are repaired (cell_cases.hpp): inside points
+/// are made outside where outside parts touch along an edge, then outside points inside where
+/// they touch at a vertex, each phase repeated until nothing changes (each is monotone, so
+/// the repair ends).
 /// Every stage is parallel (oneTBB) and writes disjoint parts of its output, and vertices
 /// and hexes are numbered in grid order, so the mesh is the same bit for bit for any number
 /// of threads.
@@ -67,7 +69,8 @@ struct ExtractOptions {
 struct ExtractReport {
   DualGrid grid;
   std::size_t inside_points = 0;       ///< inside after repair and component removal
-  std::size_t filled_points = 0;       ///< made inside by the manifold repair
+  std::size_t filled_points = 0;       ///< made inside by the manifold repair (vertex contacts)
+  std::size_t carved_points = 0;       ///< made outside by the manifold repair (edge contacts)
   std::size_t repair_rounds = 0;
   std::size_t dropped_components = 0;  ///< parts below min_component
   std::size_t dropped_hexes = 0;

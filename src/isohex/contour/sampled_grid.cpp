@@ -40,61 +40,133 @@ SampledGrid sample_region(const Region& region, const DualGrid& grid) {
     throw Error(fmt::format("a grid of {} x {} x {} points is too large (over 2^31 points); use a larger cell size",
                             grid.points[0], grid.points[1], grid.points[2]));
   g.inside.assign(static_cast<std::size_t>(total), 0);
+  g.level.assign(static_cast<std::size_t>(total), 0.0f);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(1, g.padded[2] - 1), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t k = r.begin(); k != r.end(); ++k)
       for (std::size_t j = 1; j + 1 < g.padded[1]; ++j)
         for (std::size_t i = 1; i + 1 < g.padded[0]; ++i) {
           const Vec3 p = g.position(i, j, k);
-          bool in = true;
-          for (const LevelSet& s : region.surfaces)
-            if (!(s.level(p) > 0)) {  // L == 0 (and NaN) is outside
-              in = false;
-              break;
-            }
+          double l = std::numeric_limits<double>::infinity();
+          for (const LevelSet& s : region.surfaces) l = std::min(l, s.level(p));
+          const bool in = l > 0;  // L == 0 (and NaN) is outside
           g.inside[g.index(i, j, k)] = in;
+          g.level[g.index(i, j, k)] = in ? static_cast<float>(l) : 0.0f;
         }
   });
   return g;
 }
 
-std::size_t repair_manifold(SampledGrid& g, std::size_t* rounds) {
+namespace {
+
+// Rounds of one repair phase: `edit(mask, i, j, k)` gives the corners of cell (i, j, k) to
+// flip to `to`; every cell is checked, then only the slabs around flipped points, until a
+// round flips nothing. Proposals are gathered before any is applied, so the result does not
+// depend on the thread count. Returns the points flipped and adds the rounds to `rounds`.
+template <typename Edit>
+std::size_t repair_phase(SampledGrid& g, std::uint8_t to, std::size_t& rounds, Edit&& edit) {
   const std::size_t nk = g.num_cells(2);
-  // Slabs of cells to (re)check: all at first, then those around the points just filled.
   std::vector<std::uint8_t> dirty(nk, 1);
-  std::vector<std::vector<std::size_t>> fills(nk);
-  std::size_t added = 0, round = 0;
-  for (;; ++round) {
+  std::vector<std::vector<std::size_t>> flips(nk);
+  std::size_t total = 0;
+  for (;;) {
+    ++rounds;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nk), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        fills[k].clear();
+        flips[k].clear();
         if (!dirty[k]) continue;
         for (std::size_t j = 0; j < g.num_cells(1); ++j)
           for (std::size_t i = 0; i < g.num_cells(0); ++i) {
             const std::uint8_t m = g.cell_mask(i, j, k);
             if (cell_case(m).manifold) continue;
-            const std::uint8_t f = manifold_fill(m, g.padding_mask(i, j, k));
+            const std::uint8_t f = edit(m, i, j, k);
             for (int c = 0; c < 8; ++c)
-              if (f & (1u << c)) fills[k].push_back(g.index(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)));
+              if (f & (1u << c)) flips[k].push_back(g.index(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)));
           }
       }
     });
     std::fill(dirty.begin(), dirty.end(), 0);
     std::size_t changed = 0;
     const std::size_t plane = g.padded[0] * g.padded[1];
-    for (const auto& slab : fills)
+    for (const auto& slab : flips)
       for (std::size_t p : slab) {
-        if (g.inside[p]) continue;  // two cells asked for the same point
-        g.inside[p] = 1;
+        if (g.inside[p] == to) continue;  // two cells asked for the same point
+        g.inside[p] = to;
         ++changed;
         const std::size_t pk = p / plane;  // the point touches cell slabs pk - 1 and pk
         if (pk > 0) dirty[pk - 1] = 1;
         if (pk < nk) dirty[pk] = 1;
       }
-    added += changed;
-    if (changed == 0) break;
+    total += changed;
+    if (changed == 0) return total;
   }
-  if (rounds) *rounds = round + 1;
-  return added;
+}
+
+// True when making inside point p outside leaves the inside points around it connected: the
+// inside points of its 18-neighbourhood that are face-adjacent to p form one part under
+// face adjacency within that neighbourhood. Carving such a point opens the outside without
+// cutting a bridge or deleting an isolated point.
+bool carving_keeps_inside_connected(const SampledGrid& g, std::size_t p) {
+  const std::ptrdiff_t sy = static_cast<std::ptrdiff_t>(g.padded[0]), sz = sy * static_cast<std::ptrdiff_t>(g.padded[1]);
+  // n[x][y][z] for offsets -1..1; corners of the 3x3x3 block are not in the 18-neighbourhood.
+  bool in[27] = {};
+  auto at = [](int x, int y, int z) { return (x + 1) + 3 * (y + 1) + 9 * (z + 1); };
+  for (int z = -1; z <= 1; ++z)
+    for (int y = -1; y <= 1; ++y)
+      for (int x = -1; x <= 1; ++x) {
+        if ((x == 0 && y == 0 && z == 0) || (x && y && z)) continue;
+        in[at(x, y, z)] = g.inside[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) + x + sy * y + sz * z)] != 0;
+      }
+  int label[27];
+  std::fill(std::begin(label), std::end(label), -1);
+  int parts = 0;
+  static constexpr int kFaces[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const auto& f : kFaces) {
+    const int seed = at(f[0], f[1], f[2]);
+    if (!in[seed] || label[seed] >= 0) continue;
+    if (++parts > 1) return false;
+    int stack[27], top = 0;
+    stack[top++] = seed;
+    label[seed] = 0;
+    while (top) {
+      const int q = stack[--top];
+      const int qx = q % 3 - 1, qy = q / 3 % 3 - 1, qz = q / 9 - 1;
+      for (const auto& d : kFaces) {
+        const int x = qx + d[0], y = qy + d[1], z = qz + d[2];
+        if (x < -1 || x > 1 || y < -1 || y > 1 || z < -1 || z > 1) continue;
+        const int r = at(x, y, z);
+        if (in[r] && label[r] < 0) {
+          label[r] = 0;
+          stack[top++] = r;
+        }
+      }
+    }
+  }
+  return parts == 1;
+}
+
+}  // namespace
+
+RepairCounts repair_manifold(SampledGrid& g) {
+  RepairCounts counts;
+  const std::size_t dz = g.padded[0] * g.padded[1];
+  counts.carved = repair_phase(g, 0, counts.rounds, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
+    const std::uint8_t cand = carve_candidates(m);
+    if (!cand) return std::uint8_t{0};
+    float level[8];
+    std::uint8_t allowed = 0;
+    const std::size_t base = g.index(i, j, k);
+    for (int c = 0; c < 8; ++c) {
+      const std::size_t p = base + static_cast<std::size_t>(c & 1) + g.padded[0] * static_cast<std::size_t>(c >> 1 & 1) +
+                            dz * static_cast<std::size_t>(c >> 2 & 1);
+      level[c] = g.level[p];
+      if ((cand >> c & 1) && carving_keeps_inside_connected(g, p)) allowed |= static_cast<std::uint8_t>(1u << c);
+    }
+    return manifold_carve(m, level, allowed);
+  });
+  counts.filled = repair_phase(g, 1, counts.rounds, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
+    return manifold_fill(m, g.padding_mask(i, j, k));
+  });
+  return counts;
 }
 
 ComponentCounts remove_small_components(SampledGrid& g, std::size_t min_points) {

@@ -21,6 +21,8 @@ struct SampledGrid {
   Aabb domain;
   std::array<std::size_t, 3> padded{3, 3, 3};  ///< points per axis, padding included
   std::vector<std::uint8_t> inside;             ///< 1 = inside, x fastest
+  /// min_k L_k at each point as sampled (0 on padding); the repair carves where it is lowest.
+  std::vector<float> level;
 
   [[nodiscard]] std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
     return i + padded[0] * (j + padded[1] * k);
@@ -43,9 +45,18 @@ struct SampledGrid {
 /// would have more than 2^31 points.
 SampledGrid sample_region(const Region& region, const DualGrid& grid);
 
-/// Makes outside points inside until no cell is non-manifold (manifold_fill); returns the
-/// number of points added and sets `rounds`. Deterministic for any thread count.
-std::size_t repair_manifold(SampledGrid& g, std::size_t* rounds = nullptr);
+/// What repair_manifold changed.
+struct RepairCounts {
+  std::size_t carved = 0;  ///< inside points made outside (edge contacts)
+  std::size_t filled = 0;  ///< outside points made inside (vertex contacts)
+  std::size_t rounds = 0;
+};
+
+/// Makes the grid manifold in two monotone phases, so it ends: first, while some cell has
+/// outside parts touching along an edge, makes inside points outside (manifold_carve); then,
+/// while some cell is non-manifold, makes outside points inside (manifold_fill; this can
+/// create new edge contacts, which it fills too). Deterministic for any thread count.
+RepairCounts repair_manifold(SampledGrid& g);
 
 /// Labels the face-connected parts of the inside points (which are the connected parts of
 /// the hex mesh) and removes those with fewer than `min_points` points. Returns the numbers

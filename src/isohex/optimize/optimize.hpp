@@ -72,6 +72,7 @@ struct UntangleOptions {
   int max_iter = 200;     ///< outer iterations (ε updates)
   int sweeps = 4;         ///< Gauss–Seidel sweeps per outer iteration
   double lambda = 0.5;    ///< weight of the volume term (D² + 1)/χ
+  int rings = 3;          ///< move only vertices within this many hex-rings of hexes below the margin
   ProgressCallback progress;
 };
 
@@ -87,7 +88,9 @@ struct UntangleResult {
   std::vector<Index> impossible;
 };
 
-/// Untangles `mesh` in place, vertices with fixed[v] != 0 untouched.
+/// Untangles `mesh` in place, vertices with fixed[v] != 0 untouched. If the margin is not
+/// reached, the mesh is left in the best state seen (fewest inverted hexes, then highest
+/// minimum scaled Jacobian), never worse than the input by that order.
 UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const UntangleOptions& options = {});
 
 /// Options of the shape optimiser.

@@ -27,6 +27,27 @@ double min_det(const HexMesh& mesh, const std::vector<double>& inv_len) {
       [](double a, double b) { return std::min(a, b); });
 }
 
+// The vertices within `rings` hex-rings of the hexes below the margin: the only ones the
+// untangler moves. Far-away vertices sit near their energy minimum already; sweeping them
+// would cost most of the time on a large mesh with a few tangled spots.
+std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& inc, double margin, int rings) {
+  const std::vector<double> sj = scaled_jacobians(mesh);
+  std::vector<std::uint8_t> active(mesh.points.size(), 0);
+  for (Index h = 0; h < mesh.num_hexes(); ++h)
+    if (sj[h] < margin || is_degenerate(sj[h]))
+      for (Index v : mesh.hexes[h]) active[v] = 1;
+  for (int r = 0; r < rings; ++r) {
+    std::vector<std::uint8_t> grown = active;
+    for (Index v = 0; v < mesh.num_vertices(); ++v)
+      if (active[v])
+        for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+          for (Index w : mesh.hexes[inc.ids[i]]) grown[w] = 1;
+    active.swap(grown);
+  }
+  for (std::uint8_t& a : active) a = !a;
+  return active;
+}
+
 double chi(double D, double eps) {
   const double s = std::sqrt(eps * eps + D * D);
   return D >= 0 ? 0.5 * (D + s) : eps * eps / (2 * (s - D));
@@ -68,13 +89,23 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   opt::EnergyParams params{true, 1.0, options.lambda};
   double best_min = stats.min;
   int since_best = 0;
+  // The best state seen (fewest inverted hexes, then highest minimum): the energy is global,
+  // so an iteration can trade the worst hex for the rest; a failed run must not end worse
+  // than it could have.
+  std::vector<Vec3> best_points = mesh.points;
+  opt::SJStats best = stats;
   for (int it = 1; it <= options.max_iter; ++it) {
     const double e_before = opt::total_energy(mesh, inv_len, params);
-    for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, {}, 2);
+    const std::vector<std::uint8_t> frozen = frozen_outside(mesh, inc, options.margin, options.rings);
+    for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2);
     const double e_after = opt::total_energy(mesh, inv_len, params);
     stats = opt::sj_stats(mesh);
     res.iterations = it;
     if (options.progress) options.progress({"untangle", it, e_after / (9.0 * mesh.num_hexes()), stats.min, stats.inverted});
+    if (stats.inverted < best.inverted || (stats.inverted == best.inverted && stats.min > best.min)) {
+      best = stats;
+      best_points = mesh.points;
+    }
     if (stats.min >= options.margin) {
       res.reached_margin = true;
       break;
@@ -95,6 +126,10 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     const double mu = (1 - sigma) * chi(dmin, params.eps);
     params.eps = dmin < mu ? 2 * std::sqrt(mu * (mu - dmin)) : params.eps * (1 - sigma);
     params.eps = std::max(params.eps, 1e-12);
+  }
+  if (!res.reached_margin) {
+    mesh.points.swap(best_points);
+    stats = best;
   }
   res.min_sj = stats.min;
   res.inverted = stats.inverted;
