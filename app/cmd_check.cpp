@@ -71,7 +71,7 @@ void run(const Args& a) {
                        {"vertices", r.num_boundary_vertices},
                        {"components", r.num_boundary_components},
                        {"euler_characteristic", r.euler_characteristic}};
-    io::write_atomically(a.json, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+    write_json(a.json, j);
   }
   if (!ok) exit_code() = 1;
 }

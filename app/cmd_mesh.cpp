@@ -238,7 +238,7 @@ void run(const Args& a) {
     nlohmann::json sm = nlohmann::json::array();
     for (std::size_t k = 0; k < smoothing.size(); ++k) sm.push_back(smoothing_json(region.surfaces[k], smoothing[k]));
     j["surface_smoothing"] = sm;
-    io::write_atomically(a.json, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+    write_json(a.json, j);
   }
   if (!check.valid() || dist.off_surface > 0) exit_code() = 1;
 }

@@ -62,7 +62,7 @@ void run(const Args& a) {
     j["vertices_after"] = r.mesh.num_vertices();
     j["multi_boundary_hexes_before"] = multi_before;
     j["multi_boundary_hexes_after"] = multi_after;
-    io::write_atomically(a.json, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+    write_json(a.json, j);
   }
 }
 

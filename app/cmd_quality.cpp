@@ -143,7 +143,7 @@ void run(const Args& a) {
   }
 
   if (!a.per_element.empty()) write_csv(a.per_element, metrics, all_values);
-  if (!a.json.empty()) io::write_atomically(a.json, [&](std::ostream& os) { os << report.dump(2) << '\n'; });
+  if (!a.json.empty()) write_json(a.json, report);
 }
 
 }  // namespace

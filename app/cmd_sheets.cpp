@@ -62,7 +62,7 @@ void run(const Args& a) {
     j["boundary_components"] = comps;
     j["components_captured_by_one_sheet"] = single;
     j["multi_boundary_hexes"] = r.multi_boundary_hexes;
-    io::write_atomically(a.json, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+    write_json(a.json, j);
   }
 }
 

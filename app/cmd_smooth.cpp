@@ -91,7 +91,7 @@ void run(const Args& a) {
       for (std::size_t i = 0; i < u.impossible.size() && i < 20; ++i) ids += fmt::format(" {}", u.impossible[i]);
       fmt::print("untangle: {} hexes have an inverted corner made of fixed vertices only and cannot be repaired:{}{}\n",
                  u.impossible.size(), ids, u.impossible.size() > 20 ? " ..." : "");
-      if (!a.json.empty()) io::write_atomically(a.json, [&](std::ostream& os) { os << report.dump(2) << '\n'; });
+      if (!a.json.empty()) write_json(a.json, report);
       exit_code() = 1;
       return;  // nothing written: the requested result does not exist
     }
@@ -130,7 +130,7 @@ void run(const Args& a) {
   report["seconds"] = seconds;
 
   io::write_mesh(a.out, mesh);
-  if (!a.json.empty()) io::write_atomically(a.json, [&](std::ostream& os) { os << report.dump(2) << '\n'; });
+  if (!a.json.empty()) write_json(a.json, report);
   if (a.untangle && after.inverted + after.degenerate > 0) exit_code() = 1;
 }
 

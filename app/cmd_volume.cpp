@@ -116,7 +116,7 @@ void run_info(const InfoArgs& a) {
     for (std::size_t i = 0; i <= h.counts.size(); ++i) edges.push_back(h.edge(i));
     j["histogram"] = {{"edges", edges}, {"counts", h.counts}};
   }
-  io::write_atomically(a.json, [&](std::ostream& os) { os << j.dump(2) << '\n'; });
+  write_json(a.json, j);
 }
 
 struct ConvertArgs {

@@ -23,12 +23,17 @@ int& exit_code();
 
 #include "isohex/mesh/hex_mesh.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace isohex::cli {
 
 /// Reads a mesh for a command; prints how many non-hex cells were dropped, if any.
 HexMesh load_mesh(const std::string& file, bool skip_non_hex);
+
+/// Writes `json` (indented) to `file`, atomically.
+void write_json(const std::string& file, const nlohmann::json& json);
 
 /// Fails before any work if `file` is not a writable volume format (.nrrd, .vti).
 void require_volume_output(const std::string& file);

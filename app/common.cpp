@@ -2,6 +2,7 @@
 #include "commands.hpp"
 
 #include "isohex/error.hpp"
+#include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
 
 #include <fmt/format.h>
@@ -9,6 +10,7 @@
 
 #include <cctype>
 #include <filesystem>
+#include <ostream>
 
 namespace isohex::cli {
 
@@ -20,6 +22,10 @@ HexMesh load_mesh(const std::string& file, bool skip_non_hex) {
   if (report.skipped_cells)
     fmt::print("{}: skipped {} non-hexahedral cells (--skip-non-hex)\n", file, report.skipped_cells);
   return mesh;
+}
+
+void write_json(const std::string& file, const nlohmann::json& json) {
+  io::write_atomically(file, [&](std::ostream& os) { os << json.dump(2) << '\n'; });
 }
 
 void require_volume_output(const std::string& file) {
