@@ -128,18 +128,10 @@ void run(const Args& a) {
 
   // The surface's own quality: scaled Jacobian of the boundary quads.
   if (!boundary.empty()) {
-    double lo = kVerdictDblMax, sum = 0;
-    std::size_t bad = 0;
-    for (const Quad& q : boundary) {
-      const double v = quad_scaled_jacobian({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
-      lo = std::min(lo, v);
-      sum += v;
-      bad += v < kQuestionableSJ;
-    }
-    fmt::print("boundary quad scaled_jacobian: min {:.6g}  mean {:.6g}  below {}: {}\n", lo,
-               sum / static_cast<double>(boundary.size()), kQuestionableSJ, bad);
-    report["boundary_quad_scaled_jacobian"] = {
-        {"min", lo}, {"mean", sum / static_cast<double>(boundary.size())}, {"below_0.2", bad}};
+    const QuadSummary bq = summarize_quads(mesh, boundary);
+    fmt::print("boundary quad scaled_jacobian: min {:.6g}  mean {:.6g}  below {}: {}\n", bq.min, bq.mean,
+               kQuestionableSJ, bq.below);
+    report["boundary_quad_scaled_jacobian"] = {{"min", bq.min}, {"mean", bq.mean}, {"below_0.2", bq.below}};
   }
 
   if (!a.per_element.empty()) write_csv(a.per_element, metrics, all_values);

@@ -1,6 +1,7 @@
 #include "isohex/mesh/validate.hpp"
 
 #include "isohex/mesh/topology.hpp"
+#include "isohex/mesh/union_find.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -49,17 +50,6 @@ class Collector {
  private:
   ValidationReport& r_;
   std::size_t max_;
-};
-
-// Union-find with path halving; used for boundary components and vertex links.
-struct DisjointSets {
-  std::vector<Index> parent;
-  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  Index find(Index x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(Index a, Index b) { parent[find(a)] = find(b); }
 };
 
 void check_vertices_and_ids(const HexMesh& mesh, Collector& out, ValidationReport& r) {
@@ -130,7 +120,7 @@ void check_boundary(const HexMesh& mesh, const std::vector<Quad>& boundary, Coll
   // Vertex links: around a manifold boundary vertex the quads form a single fan, so the
   // link edges (the vertex's two neighbours in each quad) form one connected cycle.
   const Incidence inc = vertex_cells(boundary, mesh.num_vertices());
-  DisjointSets components(mesh.points.size());
+  detail::UnionFind components(mesh.points.size());
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
     const std::size_t n = inc.count(v);
     if (n == 0) continue;
@@ -147,7 +137,7 @@ void check_boundary(const HexMesh& mesh, const std::vector<Quad>& boundary, Coll
     for (auto& e : link) nodes.insert(nodes.end(), e.begin(), e.end());
     std::sort(nodes.begin(), nodes.end());
     nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-    DisjointSets pieces(nodes.size());
+    detail::UnionFind pieces(nodes.size());
     auto at = [&](Index x) { return static_cast<Index>(std::lower_bound(nodes.begin(), nodes.end(), x) - nodes.begin()); };
     for (auto& e : link) pieces.unite(at(e[0]), at(e[1]));
     std::size_t npieces = 0;

@@ -1,6 +1,7 @@
 #include "isohex/quality/summary.hpp"
 
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -89,6 +90,26 @@ MetricSummary summarize(HexMetric m, const std::vector<double>& values, std::siz
   const std::size_t k = std::min(worst, all.size());
   std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end(), worse);
   s.worst.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k));
+  return s;
+}
+
+QuadSummary summarize_quads(const HexMesh& mesh, const std::vector<Quad>& quads) {
+  std::vector<double> sj(quads.size());
+  tbb::parallel_for(std::size_t{0}, quads.size(), [&](std::size_t i) {
+    const Quad& q = quads[i];
+    sj[i] = quad_scaled_jacobian({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
+  });
+  QuadSummary s;
+  s.count = quads.size();
+  if (quads.empty()) return s;
+  s.min = std::numeric_limits<double>::infinity();
+  double sum = 0;
+  for (double v : sj) {
+    s.min = std::min(s.min, v);
+    sum += v;
+    s.below += v < kQuestionableSJ;
+  }
+  s.mean = sum / static_cast<double>(quads.size());
   return s;
 }
 

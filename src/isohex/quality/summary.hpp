@@ -51,6 +51,17 @@ struct MetricSummary {
 /// 20 equal bins over [min, max]. Sequential sums keep the mean identical for any thread count.
 MetricSummary summarize(HexMetric m, const std::vector<double>& values, std::size_t worst = 10);
 
+/// Scaled Jacobian of a set of quads (e.g. the boundary of a hex mesh).
+struct QuadSummary {
+  std::size_t count = 0;
+  double min = 0, mean = 0;        ///< 0 when there are no quads
+  std::size_t below = 0;           ///< quads with scaled Jacobian < kQuestionableSJ
+};
+
+/// Summarises Verdict's quad scaled Jacobian over `quads` of `mesh` (parallel; the mean is
+/// summed in quad order, so it does not depend on the thread count).
+QuadSummary summarize_quads(const HexMesh& mesh, const std::vector<Quad>& quads);
+
 /// JSON object of a summary (histogram and worst elements included).
 nlohmann::json to_json(const MetricSummary& s);
 

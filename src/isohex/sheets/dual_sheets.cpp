@@ -3,7 +3,7 @@
 
 #include "isohex/error.hpp"
 #include "isohex/mesh/topology.hpp"
-#include "isohex/sheets/union_find.hpp"
+#include "isohex/mesh/union_find.hpp"
 
 #include <fmt/format.h>
 

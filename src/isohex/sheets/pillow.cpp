@@ -5,7 +5,7 @@
 #include "isohex/mesh/topology.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/quality/hex_quality.hpp"
-#include "isohex/sheets/union_find.hpp"
+#include "isohex/mesh/union_find.hpp"
 
 #include <fmt/format.h>
 

@@ -87,21 +87,11 @@ void check_boundary_in_grid(const HexMesh& mesh, const std::vector<std::uint8_t>
 
 SurfaceQuality quality_of(const HexMesh& mesh, const std::vector<Quad>& quads) {
   SurfaceQuality q;
-  std::vector<double> qsj(quads.size());
-  tbb::parallel_for(std::size_t{0}, quads.size(), [&](std::size_t i) {
-    std::array<Vec3, 4> c;
-    for (int k = 0; k < 4; ++k) c[k] = mesh.points[quads[i][k]];
-    qsj[i] = quad_scaled_jacobian(c);
-  });
-  q.num_quads = quads.size();
-  q.quad_sj_min = quads.empty() ? 0 : std::numeric_limits<double>::infinity();
-  double sum = 0;  // sequential: the same mean for any thread count
-  for (double s : qsj) {
-    q.quad_sj_min = std::min(q.quad_sj_min, s);
-    sum += s;
-    if (s < kQuestionableSJ) ++q.quads_below;
-  }
-  q.quad_sj_mean = quads.empty() ? 0 : sum / static_cast<double>(quads.size());
+  const QuadSummary qs = summarize_quads(mesh, quads);
+  q.num_quads = qs.count;
+  q.quad_sj_min = qs.min;
+  q.quad_sj_mean = qs.mean;
+  q.quads_below = qs.below;
   const MetricSummary hs = summarize(HexMetric::scaled_jacobian, scaled_jacobians(mesh), 0);
   q.hex_sj_min = hs.min;
   q.hexes_inverted = hs.inverted;

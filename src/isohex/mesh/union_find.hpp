@@ -1,6 +1,6 @@
 #pragma once
 /// \file union_find.hpp
-/// \brief Disjoint sets with path halving and union by size (internal to the sheets stage).
+/// \brief Disjoint sets with path halving and union by size (used by validation, sheets and component counts).
 
 #include "isohex/mesh/hex_mesh.hpp"
 
