@@ -1,8 +1,11 @@
 #pragma once
 /// \file big_endian.hpp
-/// \brief Loading and storing big-endian numbers (legacy VTK binary is always big-endian).
+/// \brief Loading and storing numbers in a byte order other than the host's (legacy VTK
+/// binary is always big-endian; NRRD, NIfTI and raw volumes may be either).
 
+#include <algorithm>
 #include <bit>
+#include <cstring>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -39,6 +42,18 @@ T load_be(const unsigned char* p) {
   std::uint64_t u = 0;
   for (std::size_t i = 0; i < sizeof(T); ++i) u = (u << 8) | p[i];
   return std::bit_cast<T>(static_cast<U>(u));
+}
+
+/// The value of type T stored at `p` (no alignment needed), its bytes reversed if `swap`.
+template <class T>
+T load_swapped(const unsigned char* p, bool swap) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, p, sizeof(T));
+  if (swap) std::reverse(b, b + sizeof(T));
+  T v;
+  std::memcpy(&v, b, sizeof(T));
+  return v;
 }
 
 /// Stores `value` big-endian at `p` (sizeof(T) bytes).

@@ -1,5 +1,7 @@
 #include "isohex/volume/decode.hpp"
 
+#include "isohex/io/big_endian.hpp"
+
 #include "isohex/error.hpp"
 #include "isohex/io/format_support.hpp"
 #include "isohex/io/text_scanner.hpp"
@@ -23,16 +25,6 @@ namespace {
 constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
 
 template <class T>
-T load(const unsigned char* p, bool swap) {
-  unsigned char b[sizeof(T)];
-  std::memcpy(b, p, sizeof(T));
-  if (swap) std::reverse(b, b + sizeof(T));
-  T v;
-  std::memcpy(&v, b, sizeof(T));
-  return v;
-}
-
-template <class T>
 void decode_typed(ByteSource& source, bool big_endian, Volume& volume, const fs::path& file, std::string_view what) {
   const bool swap = sizeof(T) > 1 && big_endian != (std::endian::native == std::endian::big);
   const std::size_t n = volume.size();
@@ -48,7 +40,7 @@ void decode_typed(ByteSource& source, bool big_endian, Volume& volume, const fs:
                        "sizes or type are wrong)",
                        first * sizeof(T) + got, n * sizeof(T), n, scalar_type_name(volume.source_type)));
     for (std::size_t i = 0; i < count; ++i)
-      out[first + i] = static_cast<float>(load<T>(buf.data() + i * sizeof(T), swap));
+      out[first + i] = static_cast<float>(io::load_swapped<T>(buf.data() + i * sizeof(T), swap));
   }
 }
 

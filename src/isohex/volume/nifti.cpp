@@ -3,6 +3,7 @@
 // scl_inter applied when the slope is nonzero, and the grid placed by the sform (when
 // sform_code > 0), else the qform (qform_code > 0), else pixdim alone.
 #include "isohex/error.hpp"
+#include "isohex/io/big_endian.hpp"
 #include "isohex/volume/decode.hpp"
 #include "isohex/volume/formats.hpp"
 
@@ -28,12 +29,7 @@ class Header {
   void set_swap(bool swap) { swap_ = swap; }
   template <class T>
   [[nodiscard]] T get(std::size_t offset) const {
-    unsigned char b[sizeof(T)];
-    std::memcpy(b, b_ + offset, sizeof(T));
-    if (swap_) std::reverse(b, b + sizeof(T));
-    T v;
-    std::memcpy(&v, b, sizeof(T));
-    return v;
+    return io::load_swapped<T>(b_ + offset, swap_);
   }
   [[nodiscard]] std::int16_t i16(std::size_t o) const { return get<std::int16_t>(o); }
   [[nodiscard]] float f32(std::size_t o) const { return get<float>(o); }
