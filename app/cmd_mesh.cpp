@@ -189,8 +189,9 @@ void run(const Args& a) {
 
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
              out.mesh.num_hexes(), out.mesh.num_vertices(), r.surface_vertices, r.box_vertices, check.num_boundary_quads);
-  fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds; {} cells split\n",
-             r.carved_points, r.filled_points, r.repair_rounds, r.split_cells);
+  fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds ({} simple, topology kept; {} "
+             "forced); {} cells split\n",
+             r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.forced_points, r.split_cells);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -223,6 +224,16 @@ void run(const Args& a) {
     j["valid"] = check.valid();
     j["filled_points"] = r.filled_points;
     j["carved_points"] = r.carved_points;
+    j["simple_points"] = r.simple_points;
+    j["forced_points"] = r.forced_points;
+    // Every sample the repair flipped, so that the topology claims can be checked.
+    nlohmann::json edits = nlohmann::json::array();
+    for (const auto& e : r.edits) {
+      const Vec3 x = r.grid.origin + r.grid.h * Vec3(static_cast<double>(e.point[0]), static_cast<double>(e.point[1]),
+                                                     static_cast<double>(e.point[2]));
+      edits.push_back({{"grid", e.point}, {"position", {x[0], x[1], x[2]}}, {"inside", e.inside}, {"simple", e.simple}});
+    }
+    j["repair_edits"] = edits;
     j["split_cells"] = r.split_cells;
     j["dropped_components"] = r.dropped_components;
     j["dropped_hexes"] = r.dropped_hexes;

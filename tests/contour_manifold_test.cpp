@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -48,6 +49,59 @@ void expect_closed_manifold(const Meshed& m) {
   EXPECT_TRUE(m.check.topology_checked);
   // A closed surface: every boundary edge has two quads, so 2E = 4F.
   EXPECT_EQ(2 * m.check.num_boundary_edges, 4 * m.check.num_boundary_quads);
+}
+
+// Components of the inside points (6-adjacency) and of the outside points (18-adjacency,
+// counting the space around the volume as outside): marching cubes' topology of the samples.
+struct DigitalTopology {
+  int inside = 0, outside = 0;
+  bool operator==(const DigitalTopology&) const = default;
+};
+DigitalTopology digital_topology(const std::vector<std::uint8_t>& in, Index n) {
+  const Index m = n + 2;  // padded by one outside point on every side
+  std::vector<int> label(static_cast<std::size_t>(m * m * m), -1);
+  auto flag = [&](Index x, Index y, Index z) -> int {
+    if (x < 1 || y < 1 || z < 1 || x > n || y > n || z > n) return 0;
+    return in[static_cast<std::size_t>((x - 1) + n * ((y - 1) + n * (z - 1)))];
+  };
+  DigitalTopology t;
+  for (Index s = 0; s < m * m * m; ++s) {
+    if (label[static_cast<std::size_t>(s)] >= 0) continue;
+    const Index sx = s % m, sy = s / m % m, sz = s / (m * m);
+    const int value = flag(sx, sy, sz), reach = value ? 1 : 2;
+    ++(value ? t.inside : t.outside);
+    std::vector<Index> stack{s};
+    label[static_cast<std::size_t>(s)] = 1;
+    while (!stack.empty()) {
+      const Index p = stack.back();
+      stack.pop_back();
+      const Index px = p % m, py = p / m % m, pz = p / (m * m);
+      for (Index dz = -1; dz <= 1; ++dz)
+        for (Index dy = -1; dy <= 1; ++dy)
+          for (Index dx = -1; dx <= 1; ++dx) {
+            const Index d = std::abs(dx) + std::abs(dy) + std::abs(dz);
+            const Index x = px + dx, y = py + dy, z = pz + dz;
+            if (d == 0 || d > reach || x < 0 || y < 0 || z < 0 || x >= m || y >= m || z >= m) continue;
+            const Index q = x + m * (y + m * z);
+            if (label[static_cast<std::size_t>(q)] < 0 && flag(x, y, z) == value) {
+              label[static_cast<std::size_t>(q)] = 1;
+              stack.push_back(q);
+            }
+          }
+    }
+  }
+  return t;
+}
+
+// Flags of the volume's points (value > 0.5) with the repair's edits applied: all of them,
+// or only the simple ones.
+std::vector<std::uint8_t> repaired_flags(const Volume& v, const ExtractReport& r, bool simple_only) {
+  std::vector<std::uint8_t> in(v.values.size());
+  for (std::size_t i = 0; i < in.size(); ++i) in[i] = v.values[i] > 0.5f;
+  for (const auto& e : r.edits)
+    if (e.simple || !simple_only)
+      in[static_cast<std::size_t>(e.point[0] + v.dims[0] * (e.point[1] + v.dims[1] * e.point[2]))] = e.inside;
+  return in;
 }
 
 TEST(ContourCellCases, ComponentsAndManifoldness) {
@@ -109,8 +163,9 @@ TEST(ContourManifold, CubesSharingAVertexAreSeparated) {
 }
 
 TEST(ContourManifold, CavitiesTouchingAtAVertexAreRepaired) {
-  // A 6^3 solid with two single-voxel cavities meeting at a vertex: the one configuration
-  // splitting cannot fix; the repair fills one cavity.
+  // A 6^3 solid with two single-voxel cavities meeting at a vertex: marching cubes sees two
+  // cavities, but no conformal mesh with one hex per inside point can, and every flip changes
+  // the topology: the repair's forced phase fills one cavity.
   std::vector<std::array<Index, 3>> in;
   for (Index z = 1; z < 7; ++z)
     for (Index y = 1; y < 7; ++y)
@@ -119,15 +174,18 @@ TEST(ContourManifold, CavitiesTouchingAtAVertexAreRepaired) {
   const Meshed m = mesh_of(voxels(8, in));
   expect_closed_manifold(m);
   EXPECT_EQ(m.result.report.filled_points, 1u);
+  EXPECT_EQ(m.result.report.forced_points, 1u);
+  EXPECT_EQ(m.result.report.simple_points, 0u);
   EXPECT_EQ(m.check.num_boundary_components, 2u);  // the outer surface and one cavity
   EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 1);
 }
 
 TEST(ContourManifold, CavitiesTouchingAlongAnEdgeAreJoined) {
   // Marching cubes joins these two cavities through the edge (the inside corners of the
-  // ambiguous face are kept apart); with one dual vertex per inside component the cell above
-  // the edge would pinch, so the repair carves one inside point of that face, joining them
-  // into one L-shaped cavity as marching cubes does. Nothing is filled.
+  // ambiguous face are kept apart): one cavity. With one dual vertex per inside component the
+  // cell above the edge would pinch. Filling one of the two cavity points is simple (one
+  // cavity remains), as is carving an inside point of that face (an L-shaped cavity); with
+  // equal levels the repair takes the first corner of the cell, the fill of (3, 3, 3).
   std::vector<std::array<Index, 3>> in;
   for (Index z = 1; z < 7; ++z)
     for (Index y = 1; y < 7; ++y)
@@ -135,9 +193,13 @@ TEST(ContourManifold, CavitiesTouchingAlongAnEdgeAreJoined) {
         if (!(x == 3 && y == 3 && z == 3) && !(x == 4 && y == 4 && z == 3)) in.push_back({x, y, z});
   const Meshed m = mesh_of(voxels(8, in));
   expect_closed_manifold(m);
-  EXPECT_EQ(m.result.report.carved_points, 1u);
-  EXPECT_EQ(m.result.report.filled_points, 0u);
-  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 3);
+  EXPECT_EQ(m.result.report.carved_points, 0u);
+  EXPECT_EQ(m.result.report.filled_points, 1u);
+  EXPECT_EQ(m.result.report.simple_points, 1u);
+  EXPECT_EQ(m.result.report.forced_points, 0u);
+  ASSERT_EQ(m.result.report.edits.size(), 1u);
+  EXPECT_EQ(m.result.report.edits[0].point, (std::array<Index, 3>{3, 3, 3}));
+  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 1);
   EXPECT_EQ(m.check.num_boundary_components, 2u);
   EXPECT_EQ(m.check.euler_characteristic, 4);
 }
@@ -250,6 +312,7 @@ TEST(ContourManifold, SmallComponentsAreDropped) {
 // always give a valid conformal mesh with a closed manifold boundary.
 TEST(ContourManifold, RandomVolumesAlwaysGiveManifolds) {
   std::mt19937 rng(20060606);
+  std::size_t forced = 0, simple = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const Index n = 4 + trial % 5;
     const double density = 0.2 + 0.6 * (trial % 7) / 6.0;
@@ -260,8 +323,22 @@ TEST(ContourManifold, RandomVolumesAlwaysGiveManifolds) {
     SCOPED_TRACE(testing::Message() << "trial " << trial << " n " << n << " density " << density);
     expect_closed_manifold(m);
     EXPECT_EQ(m.check.euler_characteristic % 2, 0);
+    // Simple flips keep marching cubes' topology of the samples; with every flip applied the
+    // mesh has that topology: one boundary per inside part and per cavity.
+    const ExtractReport& r = m.result.report;
+    EXPECT_EQ(r.simple_points + r.forced_points, r.edits.size());
+    std::vector<std::uint8_t> before(v.values.size());
+    for (std::size_t i = 0; i < before.size(); ++i) before[i] = v.values[i] > 0.5f;
+    EXPECT_EQ(digital_topology(repaired_flags(v, r, true), n), digital_topology(before, n));
+    const DigitalTopology after = digital_topology(repaired_flags(v, r, false), n);
+    EXPECT_EQ(m.check.num_boundary_components, static_cast<std::size_t>(after.inside + after.outside - 1));
+    if (r.forced_points == 0) EXPECT_EQ(after, digital_topology(before, n));
+    forced += r.forced_points;
+    simple += r.simple_points;
     if (HasFailure()) break;
   }
+  // Random noise needs many flips, and most keep the topology.
+  EXPECT_GT(simple, 4 * forced);
 }
 
 // The same with a smooth random field and a non-aligned grid (vertices placed by the QEF).

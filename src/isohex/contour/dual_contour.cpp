@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <unordered_map>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -271,6 +272,26 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   const RepairCounts repaired = repair_manifold(g);
   rep.filled_points = repaired.filled;
   rep.carved_points = repaired.carved;
+  rep.simple_points = repaired.simple;
+  rep.forced_points = repaired.forced;
+  {
+    // Each flip's new state, walking back from the final one (a point can flip more than once).
+    std::vector<std::uint8_t> state(repaired.edits.size());
+    std::unordered_map<std::size_t, std::uint8_t> now;  // state before the later flip of a point
+    for (std::size_t e = repaired.edits.size(); e-- > 0;) {
+      const std::size_t p = repaired.edits[e].point;
+      auto it = now.find(p);
+      state[e] = it == now.end() ? g.inside[p] : it->second;
+      now[p] = static_cast<std::uint8_t>(!state[e]);
+    }
+    for (std::size_t e = 0; e < repaired.edits.size(); ++e) {
+      const std::size_t p = repaired.edits[e].point;
+      const std::size_t i = p % g.padded[0], j = p / g.padded[0] % g.padded[1], k = p / (g.padded[0] * g.padded[1]);
+      // Padded index (I, J, K) is grid point (I - 1, J - 1, K - 1).
+      rep.edits.push_back({{static_cast<Index>(i) - 1, static_cast<Index>(j) - 1, static_cast<Index>(k) - 1},
+                           state[e] != 0, repaired.edits[e].simple});
+    }
+  }
   rep.repair_rounds = repaired.rounds;
   rep.time_repair = seconds_since(t);
 

@@ -69,8 +69,19 @@ struct ExtractOptions {
 struct ExtractReport {
   DualGrid grid;
   std::size_t inside_points = 0;       ///< inside after repair and component removal
-  std::size_t filled_points = 0;       ///< made inside by the manifold repair (vertex contacts)
-  std::size_t carved_points = 0;       ///< made outside by the manifold repair (edge contacts)
+  std::size_t filled_points = 0;       ///< made inside by the manifold repair
+  std::size_t carved_points = 0;       ///< made outside by the manifold repair
+  std::size_t simple_points = 0;       ///< of the filled and carved, simple points (topology kept)
+  std::size_t forced_points = 0;       ///< of the filled and carved, edits that may change topology
+  /// Every flip of the repair in the order made: grid point (i, j, k), its state after the
+  /// flip (true = made inside), and whether it was simple. Applied to the samples, the simple
+  /// ones keep marching cubes' topology and all of them give the mesh's topology.
+  struct Edit {
+    std::array<Index, 3> point;
+    bool inside;
+    bool simple;
+  };
+  std::vector<Edit> edits;
   std::size_t repair_rounds = 0;
   std::size_t dropped_components = 0;  ///< parts below min_component
   std::size_t dropped_hexes = 0;

@@ -1,6 +1,7 @@
 #include "isohex/contour/sampled_grid.hpp"
 
 #include "isohex/contour/cell_cases.hpp"
+#include "isohex/contour/simple_point.hpp"
 #include "isohex/error.hpp"
 
 #include <fmt/format.h>
@@ -50,7 +51,7 @@ SampledGrid sample_region(const Region& region, const DualGrid& grid) {
           for (const LevelSet& s : region.surfaces) l = std::min(l, s.level(p));
           const bool in = l > 0;  // L == 0 (and NaN) is outside
           g.inside[g.index(i, j, k)] = in;
-          g.level[g.index(i, j, k)] = in ? static_cast<float>(l) : 0.0f;
+          g.level[g.index(i, j, k)] = std::isnan(l) ? 0.0f : static_cast<float>(l);
         }
   });
   return g;
@@ -63,7 +64,8 @@ namespace {
 // round flips nothing. Proposals are gathered before any is applied, so the result does not
 // depend on the thread count. Returns the points flipped and adds the rounds to `rounds`.
 template <typename Edit>
-std::size_t repair_phase(SampledGrid& g, std::uint8_t to, std::size_t& rounds, Edit&& edit) {
+std::size_t repair_phase(SampledGrid& g, std::uint8_t to, RepairCounts& counts, Edit&& edit) {
+  std::size_t& rounds = counts.rounds;
   const std::size_t nk = g.num_cells(2);
   std::vector<std::uint8_t> dirty(nk, 1);
   std::vector<std::vector<std::size_t>> flips(nk);
@@ -91,6 +93,7 @@ std::size_t repair_phase(SampledGrid& g, std::uint8_t to, std::size_t& rounds, E
       for (std::size_t p : slab) {
         if (g.inside[p] == to) continue;  // two cells asked for the same point
         g.inside[p] = to;
+        counts.edits.push_back({p, false});
         ++changed;
         const std::size_t pk = p / plane;  // the point touches cell slabs pk - 1 and pk
         if (pk > 0) dirty[pk - 1] = 1;
@@ -144,12 +147,138 @@ bool carving_keeps_inside_connected(const SampledGrid& g, std::size_t p) {
   return parts == 1;
 }
 
+// The 8 cells around padded point p (never padding), by the index of their lowest corner.
+std::array<std::size_t, 8> cells_around(const SampledGrid& g, std::size_t p) {
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  std::array<std::size_t, 8> cells{};
+  for (int c = 0; c < 8; ++c) cells[static_cast<std::size_t>(c)] = p - (c & 1) - dy * (c >> 1 & 1) - dz * (c >> 2 & 1);
+  return cells;
+}
+
+std::uint8_t mask_at(const SampledGrid& g, std::size_t cell) {
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  const std::uint8_t* p = g.inside.data() + cell;
+  return static_cast<std::uint8_t>(p[0] | p[1] << 1 | p[dy] << 2 | p[dy + 1] << 3 | p[dz] << 4 | p[dz + 1] << 5 |
+                                   p[dz + dy] << 6 | p[dz + dy + 1] << 7);
+}
+
+int non_manifold_around(const SampledGrid& g, std::size_t p) {
+  int n = 0;
+  for (std::size_t cell : cells_around(g, p)) n += !cell_case(mask_at(g, cell)).manifold;
+  return n;
+}
+
+bool simple_at(const SampledGrid& g, std::size_t p) {
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  Neighbourhood nb{};
+  for (int z = 0; z < 3; ++z)
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 3; ++x)
+        nb[static_cast<std::size_t>(x + 3 * y + 9 * z)] = g.inside[p + x + dy * y + dz * z - 1 - dy - dz] != 0;
+  return is_simple_6_18(nb);
+}
+
+// A search for a short sequence of simple flips (each simple in the state the ones before
+// it leave) that lowers the number of non-manifold cells. The first flip is a corner of the
+// target cell, each later one a corner of a non-manifold cell next to the flip before it.
+class FlipSearch {
+ public:
+  static constexpr int kMaxDepth = 5;
+  explicit FlipSearch(SampledGrid& g) : g_(g), dy_(g.padded[0]), dz_(g.padded[0] * g.padded[1]) {}
+
+  // Finds and applies the best sequence for `cell` (fewest flips, then lowest sum of |level|);
+  // returns its length, 0 if none.
+  int repair(std::size_t cell) {
+    best_len_ = 0;
+    best_score_ = std::numeric_limits<double>::infinity();
+    for (int depth = 1; depth <= kMaxDepth && best_len_ == 0; ++depth) {
+      max_depth_ = depth;
+      search({cell}, 0, 0, 0.0);
+    }
+    for (int s = 0; s < best_len_; ++s) g_.inside[best_[static_cast<std::size_t>(s)]] ^= 1;
+    return best_len_;
+  }
+  const std::size_t* flips() const { return best_.data(); }
+
+ private:
+  bool flippable(std::size_t p) const {
+    return !g_.is_padding(p % dy_, p / dy_ % g_.padded[1], p / dz_);
+  }
+
+  void search(const std::vector<std::size_t>& cells, int len, int delta, double score) {
+    for (std::size_t cell : cells)
+      for (int c = 0; c < 8; ++c) {
+        const std::size_t p = cell + (c & 1) + dy_ * (c >> 1 & 1) + dz_ * (c >> 2 & 1);
+        if (!flippable(p) || std::find(path_.begin(), path_.begin() + len, p) != path_.begin() + len) continue;
+        const double sc = score + std::abs(static_cast<double>(g_.level[p]));
+        if (!(sc < best_score_)) continue;
+        if (!simple_at(g_, p)) continue;
+        const int before = non_manifold_around(g_, p);
+        g_.inside[p] ^= 1;
+        const int after = non_manifold_around(g_, p);
+        path_[static_cast<std::size_t>(len)] = p;
+        const int d = delta + after - before;
+        if (d < 0) {
+          best_ = path_;
+          best_len_ = len + 1;
+          best_score_ = sc;
+        } else if (len + 1 < max_depth_) {
+          std::vector<std::size_t> next;
+          for (std::size_t q : cells_around(g_, p))
+            if (!cell_case(mask_at(g_, q)).manifold) next.push_back(q);
+          if (!next.empty()) search(next, len + 1, d, sc);
+        }
+        g_.inside[p] ^= 1;
+      }
+  }
+
+  SampledGrid& g_;
+  std::size_t dy_, dz_;
+  int max_depth_ = 1, best_len_ = 0;
+  double best_score_ = 0;
+  std::array<std::size_t, kMaxDepth> path_{}, best_{};
+};
+
+// The topology-preserving phase: each non-manifold cell in turn gets the best short sequence
+// of simple flips (for marching cubes' (6, 18) topology) that lowers the number of
+// non-manifold cells. That number falls with every sequence, so this ends; sequential, in
+// cell order, so it is deterministic.
+void simple_phase(SampledGrid& g, RepairCounts& counts) {
+  const std::size_t nk = g.num_cells(2);
+  FlipSearch search(g);
+  for (;;) {
+    ++counts.rounds;
+    std::vector<std::vector<std::size_t>> found(nk);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nk), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k)
+        for (std::size_t j = 0; j < g.num_cells(1); ++j)
+          for (std::size_t i = 0; i < g.num_cells(0); ++i)
+            if (!cell_case(g.cell_mask(i, j, k)).manifold) found[k].push_back(g.index(i, j, k));
+    });
+    std::size_t flips = 0;
+    for (const auto& slab : found)
+      for (std::size_t cell : slab) {
+        if (cell_case(mask_at(g, cell)).manifold) continue;  // an earlier flip fixed it
+        const int n = search.repair(cell);
+        for (int s = 0; s < n; ++s) {
+          ++(g.inside[search.flips()[s]] ? counts.filled : counts.carved);
+          counts.edits.push_back({search.flips()[s], true});
+        }
+        flips += static_cast<std::size_t>(n);
+      }
+    counts.simple += flips;
+    if (flips == 0) return;
+  }
+}
+
 }  // namespace
 
 RepairCounts repair_manifold(SampledGrid& g) {
   RepairCounts counts;
   const std::size_t dz = g.padded[0] * g.padded[1];
-  counts.carved = repair_phase(g, 0, counts.rounds, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
+  simple_phase(g, counts);
+  const std::size_t simple_carved = counts.carved, simple_filled = counts.filled;
+  counts.carved = repair_phase(g, 0, counts, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
     const std::uint8_t cand = carve_candidates(m);
     if (!cand) return std::uint8_t{0};
     float level[8];
@@ -163,9 +292,12 @@ RepairCounts repair_manifold(SampledGrid& g) {
     }
     return manifold_carve(m, level, allowed);
   });
-  counts.filled = repair_phase(g, 1, counts.rounds, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
+  counts.filled = repair_phase(g, 1, counts, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
     return manifold_fill(m, g.padding_mask(i, j, k));
   });
+  counts.forced = counts.carved + counts.filled;
+  counts.carved += simple_carved;
+  counts.filled += simple_filled;
   return counts;
 }
 

@@ -21,7 +21,8 @@ struct SampledGrid {
   Aabb domain;
   std::array<std::size_t, 3> padded{3, 3, 3};  ///< points per axis, padding included
   std::vector<std::uint8_t> inside;             ///< 1 = inside, x fastest
-  /// min_k L_k at each point as sampled (0 on padding); the repair carves where it is lowest.
+  /// min_k L_k at each point as sampled (0 on padding and where NaN); the repair flips the
+  /// points nearest the isosurface (lowest |level|).
   std::vector<float> level;
 
   [[nodiscard]] std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
@@ -47,15 +48,26 @@ SampledGrid sample_region(const Region& region, const DualGrid& grid);
 
 /// What repair_manifold changed.
 struct RepairCounts {
-  std::size_t carved = 0;  ///< inside points made outside (edge contacts)
-  std::size_t filled = 0;  ///< outside points made inside (vertex contacts)
+  std::size_t carved = 0;  ///< inside points made outside
+  std::size_t filled = 0;  ///< outside points made inside
+  std::size_t simple = 0;  ///< of those, simple points (no change of topology)
+  std::size_t forced = 0;  ///< of those, edits that may change the topology
+  struct Edit {
+    std::size_t point;  ///< padded index
+    bool simple;
+  };
+  std::vector<Edit> edits;  ///< every flip, in the order made (simple ones first)
   std::size_t rounds = 0;
 };
 
-/// Makes the grid manifold in two monotone phases, so it ends: first, while some cell has
-/// outside parts touching along an edge, makes inside points outside (manifold_carve); then,
-/// while some cell is non-manifold, makes outside points inside (manifold_fill; this can
-/// create new edge contacts, which it fills too). Deterministic for any thread count.
+/// Makes the grid manifold. First it flips only simple points (is_simple_6_18), so the
+/// solid keeps the topology marching cubes gives the samples: in each non-manifold cell, a
+/// corner whose flip is simple and lowers the number of non-manifold cells around it, the
+/// one nearest the isosurface. What remains is forced, in two monotone phases: while some
+/// cell has outside parts touching along an edge, inside points are made outside
+/// (manifold_carve); then, while some cell is non-manifold, outside points are made inside
+/// (manifold_fill; this can create new edge contacts, which it fills too). Each phase ends;
+/// the result is the same for any thread count.
 RepairCounts repair_manifold(SampledGrid& g);
 
 /// Labels the face-connected parts of the inside points (which are the connected parts of
