@@ -2,6 +2,7 @@
 #include "commands.hpp"
 
 #include "isohex/io/atomic_file.hpp"
+#include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/quality/hex_quality.hpp"
 
@@ -81,7 +82,7 @@ void run(const Args& a) {
 void register_check(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("check", "Validate a hex mesh: ids, conformity, orientation, manifold boundary");
-  cmd->add_option("mesh", a->mesh, "Hex mesh (.vtk .vtu .mesh .inp)")->required();
+  cmd->add_option("mesh", a->mesh, fmt::format("Hex mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the validation report as JSON");
   cmd->add_option("--max-messages", a->max_messages, "Messages shown per fault kind (default 20)");
   cmd->add_flag("--strict", a->strict, "Treat warnings (unused vertices) as errors");

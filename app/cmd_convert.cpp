@@ -13,15 +13,16 @@ namespace isohex::cli {
 void register_convert(CLI::App& app) {
   struct Args {
     std::string in, out;
-    bool skip_non_hex = false, ascii = false, no_compress = false;
+    bool skip_non_hex = false, ascii = false, no_compress = false, msh_binary = false;
   };
   auto args = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert a hex mesh between formats (chosen by extension: .vtk .vtu .mesh .inp)");
+  CLI::App* cmd = app.add_subcommand("convert", fmt::format("Convert a hex mesh between formats (chosen by extension: {})", io::kMeshExtensions));
   cmd->add_option("input", args->in, "Input mesh")->required();
   cmd->add_option("output", args->out, "Output mesh")->required();
   cmd->add_flag("--skip-non-hex", args->skip_non_hex, "Drop non-hexahedral cells (and report how many) instead of failing");
   cmd->add_flag("--ascii", args->ascii, "Write .vtk/.vtu as ASCII (17 significant digits) instead of binary");
   cmd->add_flag("--no-compress", args->no_compress, "Write .vtu appended data without zlib compression");
+  cmd->add_flag("--msh-binary", args->msh_binary, "Write .msh (Gmsh 4.1) in binary instead of ASCII");
   cmd->callback([args] {
     io::ReadOptions ropt;
     ropt.skip_non_hex = args->skip_non_hex;
@@ -31,6 +32,7 @@ void register_convert(CLI::App& app) {
     io::WriteOptions wopt;
     wopt.binary = !args->ascii;
     wopt.compress = !args->no_compress;
+    wopt.msh_binary = args->msh_binary;
     io::write_mesh(args->out, mesh, wopt);
     fmt::print("wrote {}: {} hexes, {} vertices\n", args->out, mesh.num_hexes(), mesh.num_vertices());
   });

@@ -22,7 +22,7 @@ void register_generate(CLI::App& app) {
   cmd->add_option("shape", a->shape, "box (a structured grid) or ball (a cube grid mapped onto a sphere)")
       ->required()
       ->check(CLI::IsMember({"box", "ball"}));
-  cmd->add_option("-o,--output", a->out, "Output mesh (.vtk .vtu .mesh .inp)")->required();
+  cmd->add_option("-o,--output", a->out, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("-n,--resolution", a->resolution, "Cells along each axis (default 16)")->check(CLI::Range(1, 2000));
   cmd->add_option("--size", a->size, "Edge length of the box / radius of the ball (default 1)")->check(CLI::PositiveNumber);
   cmd->add_option("--jitter", a->jitter, "Random vertex displacement, as a fraction of the cell size (default 0)")

@@ -121,7 +121,7 @@ void run(const Args& a) {
   ThreadLimit limit(*a.threads);
   if (a.volume.empty() == a.shape.empty()) throw Error("give either a VOLUME file or --shape EXPR (not both)");
   if (!io::is_known_mesh_extension(a.output))
-    throw Error(fmt::format("{}: unknown mesh format (use .vtk .vtu .mesh .inp)", a.output));
+    throw Error(fmt::format("{}: unknown mesh format (use {})", a.output, io::kMeshExtensions));
   const bool terminal = ::isatty(::fileno(stdout)) != 0;
   const auto start = Clock::now();
 
@@ -281,7 +281,7 @@ void register_mesh(CLI::App& app) {
                 "Skip the geometric-flow smoothing of the boundary quads (on by default; vertices stay on the isosurface)");
   cmd->add_option("--surface-iterations", a->surface_iterations, "Iterations of the surface smoothing (default 30)")
       ->check(CLI::Range(0, 10000));
-  cmd->add_option("-o,--output", a->output, "Output mesh (.vtk .vtu .mesh .inp)")->required();
+  cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
   cmd->add_option("--dims", a->dims, "Raw files: grid points along x, y, z")->expected(3);
   cmd->add_option("--type", a->type, "Raw files: the stored value type")

@@ -3,6 +3,7 @@
 
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
+#include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/topology.hpp"
 #include "isohex/quality/summary.hpp"
 
@@ -143,7 +144,7 @@ void run(const Args& a) {
 void register_quality(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("quality", "Element quality report (Verdict's scaled Jacobian and other metrics)");
-  cmd->add_option("mesh", a->mesh, "Hex mesh (.vtk .vtu .mesh .inp)")->required();
+  cmd->add_option("mesh", a->mesh, fmt::format("Hex mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--metric", a->metrics,
                   "Metric to report, repeatable: scaled_jacobian (default), jacobian, edge_ratio, mean_ratio, shape, "
                   "skew, taper, volume, or all");

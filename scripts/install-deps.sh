@@ -7,6 +7,7 @@ pkgs=(
   libeigen3-dev libtbb-dev libcli11-dev nlohmann-json3-dev libfmt-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-vtk9 libvtk9-dev
+  libexodusii-dev libnetcdf-dev gmsh calculix-ccx
 )
 missing=()
 for p in "${pkgs[@]}"; do

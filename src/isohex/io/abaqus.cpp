@@ -8,11 +8,16 @@
 // Blocks come from the ELSET of each *ELEMENT: "EB<n>" is block n when every set is named
 // so, otherwise sets are numbered 1, 2, ... by first appearance. *NSET, NSET=FIXED lists
 // the fixed vertices. Every other keyword is skipped with its data lines.
+//
+// The writer adds what a solver deck needs to refer to: *ELSET ALLHEXES, *NSET BOUNDARY
+// (the boundary nodes) and *SURFACE BOUNDARY, the boundary quads as element faces S1..S6
+// in Abaqus' C3D8 face numbering (solver_sets.hpp).
 
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/format_support.hpp"
 #include "isohex/io/mesh_io.hpp"
+#include "isohex/io/solver_sets.hpp"
 #include "isohex/io/text_scanner.hpp"
 
 #include <fmt/format.h>
@@ -400,6 +405,13 @@ class AbaqusReader {
   std::size_t skipped_ = 0;
 };
 
+/// 1-based ids of `vertices`, 16 to a line: the most Abaqus allows on a set data line.
+void write_id_lines(TextOut& text, const std::vector<Index>& vertices) {
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    text.print("{}{}{}", i % 16 == 0 ? "" : ", ", vertices[i] + 1,
+               i % 16 == 15 || i + 1 == vertices.size() ? "\n" : "");
+}
+
 void write_inp(std::ostream& out, const HexMesh& mesh) {
   TextOut text(out);
   text.print("*HEADING\nisohex hex mesh\n*NODE, NSET=ALLNODES\n");
@@ -422,20 +434,24 @@ void write_inp(std::ostream& out, const HexMesh& mesh) {
     text.print("{}, {}, {}, {}, {}, {}, {}, {}, {}\n", h + 1, x[0] + 1, x[1] + 1, x[2] + 1, x[3] + 1, x[4] + 1,
                x[5] + 1, x[6] + 1, x[7] + 1);
   }
-  // Abaqus allows at most 16 entries per set data line.
-  std::size_t on_line = 0;
-  bool header = false;
-  for (std::size_t v = 0; v < mesh.fixed.size(); ++v) {
-    if (!mesh.fixed[v]) continue;
-    if (!header) text.print("*NSET, NSET=FIXED\n");
-    header = true;
-    text.print("{}{}", on_line == 0 ? "" : ", ", v + 1);
-    if (++on_line == 16) {
-      text.print("\n");
-      on_line = 0;
-    }
+  // Sets for the solver: all hexes, the boundary nodes, the boundary as an element-based
+  // surface (element, face label) and the fixed vertices.
+  if (!mesh.hexes.empty()) text.print("*ELSET, ELSET=ALLHEXES, GENERATE\n1, {}, 1\n", mesh.hexes.size());
+  const std::vector<Index> bnodes = boundary_nodes(mesh);
+  if (!bnodes.empty()) {
+    text.print("*NSET, NSET=BOUNDARY\n");
+    write_id_lines(text, bnodes);
   }
-  if (on_line) text.print("\n");
+  const std::vector<BoundaryFace> faces = boundary_faces(mesh);
+  if (!faces.empty()) text.print("*SURFACE, NAME=BOUNDARY, TYPE=ELEMENT\n");
+  for (const BoundaryFace& f : faces) text.print("{}, S{}\n", f.hex + 1, kAbaqusFaceOfVtkFace[f.face]);
+  std::vector<Index> fixed;
+  for (std::size_t v = 0; v < mesh.fixed.size(); ++v)
+    if (mesh.fixed[v]) fixed.push_back(static_cast<Index>(v));
+  if (!fixed.empty()) {
+    text.print("*NSET, NSET=FIXED\n");
+    write_id_lines(text, fixed);
+  }
   text.flush();
 }
 

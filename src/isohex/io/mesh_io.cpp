@@ -11,7 +11,7 @@ namespace isohex::io {
 
 namespace {
 
-enum class Format { vtk, vtu, medit, abaqus, unknown };
+enum class Format { vtk, vtu, medit, abaqus, exodus, gmsh, unknown };
 
 Format format_of(const std::filesystem::path& file) {
   std::string ext = file.extension().string();
@@ -20,11 +20,13 @@ Format format_of(const std::filesystem::path& file) {
   if (ext == ".vtu") return Format::vtu;
   if (ext == ".mesh") return Format::medit;
   if (ext == ".inp") return Format::abaqus;
+  if (ext == ".exo" || ext == ".e" || ext == ".ex2") return Format::exodus;
+  if (ext == ".msh") return Format::gmsh;
   return Format::unknown;
 }
 
 [[noreturn]] void unknown_format(const std::filesystem::path& file) {
-  throw Error(fmt::format("{}: unknown mesh format '{}' (known: .vtk .vtu .mesh .inp)", file.string(),
+  throw Error(fmt::format("{}: unknown mesh format '{}' (known: .vtk .vtu .mesh .inp .exo .e .ex2 .msh)", file.string(),
                           file.extension().string()));
 }
 
@@ -40,6 +42,8 @@ HexMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options,
     case Format::vtu: return read_vtu(file, options, r);
     case Format::medit: return read_medit(file, options, r);
     case Format::abaqus: return read_abaqus(file, options, r);
+    case Format::exodus: return read_exodus(file, options, r);
+    case Format::gmsh: return read_gmsh(file, options, r);
     case Format::unknown: break;
   }
   unknown_format(file);
@@ -51,6 +55,8 @@ void write_mesh(const std::filesystem::path& file, const HexMesh& mesh, const Wr
     case Format::vtu: return write_vtu(file, mesh, options);
     case Format::medit: return write_medit(file, mesh, options);
     case Format::abaqus: return write_abaqus(file, mesh, options);
+    case Format::exodus: return write_exodus(file, mesh, options);
+    case Format::gmsh: return write_gmsh(file, mesh, options);
     case Format::unknown: break;
   }
   unknown_format(file);

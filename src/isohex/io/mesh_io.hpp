@@ -8,6 +8,8 @@
 /// | `.vtu`         | VTK XML UnstructuredGrid: ascii, base64 inline, appended raw, zlib |
 /// | `.mesh`        | MEDIT / GMF ASCII (Vertices, Hexahedra, references)           |
 /// | `.inp`         | Abaqus input (C3D8 and its variants C3D8R, C3D8I, C3D8H, ...)  |
+/// | `.exo` `.e` `.ex2` | Exodus II (HEX8 element blocks, boundary side set and node set) |
+/// | `.msh`         | Gmsh 4.1, ASCII or binary (physical volumes per block, "boundary" surface) |
 ///
 /// Every reader throws isohex::Error naming the file, the place (line or byte offset) and
 /// the fault; it never crashes or hangs on malformed input, and refuses declared counts
@@ -38,6 +40,7 @@ struct ReadReport {
 struct WriteOptions {
   bool binary = true;     ///< .vtk/.vtu: binary (exact) rather than ASCII (17 significant digits)
   bool compress = true;   ///< .vtu: zlib-compress the appended data, as VTK does by default
+  bool msh_binary = false; ///< .msh: Gmsh's binary variant rather than ASCII (17 significant digits)
 };
 
 /// Reads a mesh, choosing the reader by extension (case-insensitive).
@@ -50,6 +53,8 @@ void write_mesh(const std::filesystem::path& file, const HexMesh& mesh,
 
 /// True if the extension of `file` names a format read_mesh/write_mesh know.
 bool is_known_mesh_extension(const std::filesystem::path& file);
+/// The extensions read_mesh/write_mesh know, for help texts and messages.
+inline constexpr const char* kMeshExtensions = ".vtk .vtu .mesh .inp .exo .e .ex2 .msh";
 
 // Per-format entry points (same contracts as above).
 HexMesh read_vtk_legacy(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
@@ -60,5 +65,9 @@ HexMesh read_medit(const std::filesystem::path& file, const ReadOptions& options
 void write_medit(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
 HexMesh read_abaqus(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
 void write_abaqus(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
+HexMesh read_exodus(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
+void write_exodus(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
+HexMesh read_gmsh(const std::filesystem::path& file, const ReadOptions& options, ReadReport* report);
+void write_gmsh(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
 
 }  // namespace isohex::io

@@ -36,6 +36,8 @@ class TextScanner {
   [[nodiscard]] bool at_end() const { return pos_ >= text_.size(); }
   /// 1-based line number of the cursor.
   [[nodiscard]] std::size_t line() const { return line_; }
+  /// Bytes after the cursor.
+  [[nodiscard]] std::size_t remaining() const { return text_.size() - pos_; }
   /// Byte offset of the cursor into the text.
   [[nodiscard]] std::size_t offset() const { return pos_; }
   /// Moves the cursor to `offset` (line counting continues from the current line).

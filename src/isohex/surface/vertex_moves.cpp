@@ -101,8 +101,14 @@ Vec3 interior_step(const MoveContext& ctx, Index v, double weight) {
     Vec3 centroid = Vec3::Zero();
     for (const Vec3& x : c) centroid += x;
     centroid *= 0.125;
-    // An inverted hex has no mass; if all are, fall back to plain centroids.
-    const double vol = std::max(volume(c), 0.0);
+    // Weight by the centre frame's determinant (the volume of the parallelepiped of the
+    // principal axes, exact for parallelepipeds): a fraction of the exact trilinear volume's
+    // cost, which dominated the sweep. An inverted hex has no mass; if all are, fall back to
+    // plain centroids.
+    const Vec3 a = (c[1] - c[0]) + (c[2] - c[3]) + (c[5] - c[4]) + (c[6] - c[7]);
+    const Vec3 b = (c[3] - c[0]) + (c[2] - c[1]) + (c[7] - c[4]) + (c[6] - c[5]);
+    const Vec3 d = (c[4] - c[0]) + (c[5] - c[1]) + (c[6] - c[2]) + (c[7] - c[3]);
+    const double vol = std::max(a.dot(b.cross(d)) / 64.0, 0.0);
     weighted += vol * centroid;
     plain += centroid;
     mass += vol;
