@@ -201,8 +201,19 @@ class FlipSearch {
   const std::size_t* flips() const { return best_.data(); }
 
  private:
+  // Not padding, and next to the isosurface: some 26-neighbour was sampled on the other side
+  // (the level's sign is the sample's own side). Flipping a point away from the surface would
+  // leave its dual vertices no surface to be projected onto.
   bool flippable(std::size_t p) const {
-    return !g_.is_padding(p % dy_, p / dy_ % g_.padded[1], p / dz_);
+    if (g_.is_padding(p % dy_, p / dy_ % g_.padded[1], p / dz_)) return false;
+    const bool in = g_.level[p] > 0;
+    for (int z = -1; z <= 1; ++z)
+      for (int y = -1; y <= 1; ++y)
+        for (int x = -1; x <= 1; ++x) {
+          const std::size_t q = p + static_cast<std::size_t>(x) + dy_ * static_cast<std::size_t>(y) + dz_ * static_cast<std::size_t>(z);
+          if ((g_.level[q] > 0) != in) return true;
+        }
+    return false;
   }
 
   void search(const std::vector<std::size_t>& cells, int len, int delta, double score) {
