@@ -19,6 +19,10 @@ namespace isohex::contour {
 
 namespace {
 
+// Fraction of the cell size kept between a dual vertex (before projection) and its cell's faces.
+constexpr double kClampMargin = 0.05;
+
+
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
@@ -153,7 +157,11 @@ Placement place_vertex(const Region& region, const SampledGrid& g, std::size_t i
     if (per_surface[s] > 0 && (surface < 0 || per_surface[s] > per_surface[surface])) surface = s;
 
   Vec3 x = qef.count() > 0 ? qef.solve() : (loose > 0 ? Vec3(loose_sum / loose) : centre);
-  for (int a = 0; a < 3; ++a) x[a] = std::clamp(x[a], lo[a], lo[a] + h);
+  // Clamped a little inside the cell: where the isosurface passes exactly through a grid
+  // point, the minimisers of all the cells around it fall on that point, and clamping to the
+  // closed cell would give them one position (degenerate hexes, e.g. at a sphere's poles).
+  const double margin = kClampMargin * h;
+  for (int a = 0; a < 3; ++a) x[a] = std::clamp(x[a], lo[a] + margin, lo[a] + h - margin);
 
   if (box_axes) {
     for (int a = 0; a < 3; ++a)
