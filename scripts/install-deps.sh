@@ -8,6 +8,7 @@ pkgs=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy python3-vtk9 libvtk9-dev
   libexodusii-dev libnetcdf-dev gmsh calculix-ccx
+  chromium python3-pil
 )
 missing=()
 for p in "${pkgs[@]}"; do
