@@ -140,7 +140,7 @@ TEST(OptimizeShape, WorstPassNeverLowersTheMinimum) {
     optimize_shape(m, m.fixed);
     const double lo = min_sj(m);
     const HexMesh before = m;
-    const WorstResult w = improve_worst(m, m.fixed, WorstOptions{0.9, 50, 5, {}});
+    const WorstResult w = improve_worst(m, m.fixed, WorstOptions{.below = 0.9, .count = 50, .passes = 5});
     EXPECT_GE(min_sj(m), lo);
     EXPECT_EQ(w.min_sj_before, lo);
     EXPECT_EQ(w.min_sj_after, min_sj(m));

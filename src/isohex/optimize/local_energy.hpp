@@ -11,6 +11,7 @@
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/mesh/topology.hpp"
 #include "isohex/optimize/optimize.hpp"
+#include "isohex/optimize/slide.hpp"
 
 #include <Eigen/Core>
 
@@ -34,6 +35,11 @@ struct EnergyParams {
   bool untangle = false;  ///< true: regularised energy (all 9 frames); false: inverse mean ratio (8 corners)
   double eps = 0;         ///< untangle: the regularisation ε
   double lambda = 0;      ///< untangle: weight of the volume term
+  /// Hexes left out of vertex energies (may be null): the untangler's given-up hexes.
+  const std::vector<std::uint8_t>* skip = nullptr;
+  /// Boundary vertices that slide (may be null): their steps are made tangential and put back
+  /// on this surface.
+  const BoundarySurface* surface = nullptr;
 };
 
 /// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
@@ -83,6 +89,7 @@ struct SJStats {
   double min = 0;
   std::size_t inverted = 0;
 };
-SJStats sj_stats(const HexMesh& mesh);
+/// With `skip`, over the other hexes only.
+SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip = nullptr);
 
 }  // namespace isohex::opt

@@ -22,12 +22,19 @@
 ///   ε lowered between sweeps. It continues past "no inverted element" until the minimum
 ///   scaled Jacobian reaches a margin, because a barrier objective must never be handed a mesh
 ///   that is invalid by rounding (the failure observed with Mesquite on pave1 and ECR bust).
+///   Hexes that the fixed vertices make impossible are proven so first (find_infeasible(): an
+///   inverted frame of fixed vertices, or an LP showing that a free vertex has no place) and
+///   given up; when the barrier stalls, max–min LP moves (each vertex to the place that
+///   maximises its smallest frame determinant) try to open the knot.
 /// - optimize_shape(): Knupp's inverse mean ratio |A|²/(3 det(A)^{2/3}) summed over the 8
 ///   corner frames of each valid hex (ideal: the unit cube corner). A move must keep all 9
 ///   determinants of every incident hex positive, so no valid hex is ever inverted, and it
 ///   must lower the objective, so the objective never increases.
 /// - improve_worst(): local max–min moves on the vertices of the worst hexes, accepted only if
 ///   the minimum scaled Jacobian (Verdict's) of the hexes around the vertex rises.
+///
+/// With a BoundarySurface (slide.hpp) in the options, its sliding boundary vertices move too:
+/// tangential steps, put back on the input's boundary surface.
 
 #include "isohex/mesh/hex_mesh.hpp"
 
@@ -38,6 +45,8 @@
 #include <vector>
 
 namespace isohex {
+
+class BoundarySurface;  // optimize/slide.hpp
 
 /// Which vertices the optimisers hold fixed.
 enum class FixedVertices {
@@ -58,7 +67,7 @@ VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_
 
 /// One line of progress.
 struct IterationReport {
-  std::string stage;        ///< "untangle", "shape" or "worst"
+  std::string stage;        ///< "untangle", "lp" (a max–min LP rescue; objective = moves), "shape" or "worst"
   int iteration = 0;
   double objective = 0;     ///< stage objective (shape: mean inverse mean ratio over corners)
   double min_sj = 0;        ///< minimum scaled Jacobian (Verdict) of the mesh
@@ -73,24 +82,49 @@ struct UntangleOptions {
   int sweeps = 4;         ///< Gauss–Seidel sweeps per outer iteration
   double lambda = 0.5;    ///< weight of the volume term (D² + 1)/χ
   int rings = 3;          ///< move only vertices within this many hex-rings of hexes below the margin
+  const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };
+
+/// A set of hexes that cannot all be valid with the given fixed vertices, and why.
+struct InfeasibleSet {
+  enum class Kind {
+    fixed_frame,  ///< a frame (a corner, or the centre of an all-fixed hex) made of fixed vertices only is
+                  ///< inverted, flat, or has an edge Verdict calls degenerate (collapsed)
+    vertex_cone,  ///< the frames in which `vertex` is the only free vertex have no common positive point (an LP proves it)
+  };
+  Kind kind = Kind::fixed_frame;
+  Index vertex = -1;          ///< fixed_frame: the frame's corner vertex; vertex_cone: the free vertex with no valid place
+  std::vector<Index> hexes;   ///< at least one of these hexes stays invalid whatever the free vertices do (ascending)
+};
+/// "fixed_frame" / "vertex_cone".
+const char* to_string(InfeasibleSet::Kind kind);
+
+/// Proofs that some hexes cannot all be made valid with `fixed` held: inverted frames of fixed
+/// vertices only, and free vertices whose frames with otherwise fixed vertices leave no place
+/// (the maximal inscribed ball of their half-spaces, an LP, has radius below 1e-9 edge lengths).
+/// Deterministic, ordered by kind, then vertex.
+std::vector<InfeasibleSet> find_infeasible(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed);
 
 /// What the untangler did.
 struct UntangleResult {
   int iterations = 0;
-  double min_sj = 0;               ///< after
-  std::size_t inverted = 0;        ///< hexes with scaled Jacobian <= 0 after
-  bool reached_margin = false;
-  /// Hexes with an inverted corner frame whose 4 vertices are all fixed (e.g. an inverted hex
-  /// with all 8 vertices fixed): no move can repair them. When there are any, untangle()
-  /// reports them and leaves the mesh unchanged.
-  std::vector<Index> impossible;
+  double min_sj = 0;               ///< after, over the hexes not given up
+  std::size_t inverted = 0;        ///< hexes with scaled Jacobian <= 0 after (all of them, given up or not)
+  bool reached_margin = false;     ///< every hex not given up reached the margin
+  std::size_t lp_moves = 0;        ///< max–min LP moves taken when the barrier stalled
+  /// find_infeasible()'s proofs, and for each one hex that the untangler gives up (leaves out
+  /// of its energy so that the rest can be untangled; chosen per proof as the lowest scaled
+  /// Jacobian among its hexes, then lowest id, until the rest of the proof's frames admit a
+  /// valid place). Only these hexes may stay inverted because of the fixed vertices.
+  std::vector<InfeasibleSet> infeasible;
+  std::vector<Index> given_up;     ///< ascending
 };
 
-/// Untangles `mesh` in place, vertices with fixed[v] != 0 untouched. If the margin is not
-/// reached, the mesh is left in the best state seen (fewest inverted hexes, then highest
-/// minimum scaled Jacobian), never worse than the input by that order.
+/// Untangles `mesh` in place, vertices with fixed[v] != 0 untouched, every hex except the
+/// given-up ones (see UntangleResult) towards the margin. If the margin is not reached, the
+/// mesh is left in the best state seen (fewest inverted hexes not given up, then highest
+/// minimum scaled Jacobian among them), never worse than the input by that order.
 UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const UntangleOptions& options = {});
 
 /// Options of the shape optimiser.
@@ -98,6 +132,7 @@ struct ShapeOptions {
   int max_iter = 100;        ///< Gauss–Seidel sweeps
   double tol = 1e-5;         ///< stop when a sweep lowers the objective by less than tol (relative)
   double grad_tol = 1e-8;    ///< ... or when the largest vertex gradient (× edge length) is below this
+  const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };
 
@@ -121,6 +156,7 @@ struct WorstOptions {
   double below = 1.5;     ///< work on the vertices of hexes with scaled Jacobian below this ...
   std::size_t count = 100;  ///< ... at most this many of the worst
   int passes = 10;
+  const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };
 

@@ -44,7 +44,9 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   double e = mean_objective(mesh, inv_len, bad);
   res.objective_before = res.objective_after = e;
   for (int it = 1; it <= options.max_iter; ++it) {
-    const double grad = opt::sweep(mesh, coloring, inc, inv_len, opt::EnergyParams{}, frozen, 1);
+    opt::EnergyParams params;
+    params.surface = options.surface;
+    const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 1);
     const double e_new = mean_objective(mesh, inv_len, bad);
     res.iterations = it;
     res.history.push_back(e_new);

@@ -1,0 +1,158 @@
+// Affine frame determinants around one vertex and the 4-unknown LP that maximises their minimum.
+#include "isohex/optimize/feasibility.hpp"
+
+#include "isohex/optimize/local_energy.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace isohex::opt {
+
+MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w, double box) {
+  MaxMin out;
+  const int m = static_cast<int>(f.size());
+  if (m == 0 || !(box > 0)) return out;
+  // Unknowns y = (u, σ) >= 0 with d = box·(u − 1), u <= 2 (the cube), and s = σ − S, S chosen
+  // so that y = 0 is feasible: f_i(d) >= s·w_i  ⇔  −box a_i·u + w_i σ <= b_i − box a_i·1 + S w_i.
+  double S = 0;
+  for (int i = 0; i < m; ++i) S = std::max(S, (box * f[i].a.sum() - f[i].b) / w[i]);
+  S += 1;
+  const int rows = m + 3;
+  // Dictionary form: x_B[i] = q[i] − Σ_j M[i][j] x_N[j], objective z = const + Σ_j c[j] x_N[j].
+  std::vector<double> M(static_cast<std::size_t>(rows) * 4, 0.0), q(rows);
+  std::vector<int> B(rows), N{0, 1, 2, 3};
+  auto at = [&](int i, int j) -> double& { return M[static_cast<std::size_t>(i) * 4 + j]; };
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < 3; ++j) at(i, j) = -box * f[i].a[j];
+    at(i, 3) = w[i];
+    q[i] = f[i].b - box * f[i].a.sum() + S * w[i];
+  }
+  for (int j = 0; j < 3; ++j) {
+    at(m + j, j) = 1;
+    q[m + j] = 2;
+  }
+  for (int i = 0; i < rows; ++i) B[i] = 4 + i;
+  double c[4] = {0, 0, 0, 1};  // reduced costs; the objective value itself is read off the solution
+  constexpr double tol = 1e-12;
+  for (int pivots = 0; pivots < 50 * rows; ++pivots) {
+    // Bland's rule (smallest variable index enters and leaves) cannot cycle.
+    int e = -1;
+    for (int j = 0; j < 4; ++j)
+      if (c[j] > tol && (e < 0 || N[j] < N[e])) e = j;
+    if (e < 0) {
+      double y[4] = {0, 0, 0, 0};
+      for (int i = 0; i < rows; ++i)
+        if (B[i] < 4) y[B[i]] = q[i];
+      out.d = box * (Vec3(y[0], y[1], y[2]) - Vec3::Ones());
+      out.s = y[3] - S;
+      out.ok = true;
+      return out;
+    }
+    int r = -1;
+    double best = 0;
+    for (int i = 0; i < rows; ++i) {
+      if (!(at(i, e) > tol)) continue;
+      const double ratio = q[i] / at(i, e);
+      if (r < 0 || ratio < best || (ratio == best && B[i] < B[r])) r = i, best = ratio;
+    }
+    if (r < 0) return out;  // unbounded: cannot happen with the cube and w > 0
+    const double p = at(r, e);
+    for (int j = 0; j < 4; ++j) at(r, j) = j == e ? 1 / p : at(r, j) / p;
+    q[r] /= p;
+    for (int i = 0; i < rows; ++i) {
+      if (i == r) continue;
+      const double k = at(i, e);
+      if (k == 0) continue;
+      for (int j = 0; j < 4; ++j) at(i, j) = j == e ? -k / p : at(i, j) - k * at(r, j);
+      q[i] = std::max(q[i] - k * q[r], 0.0);  // clamp rounding: the dictionary stays feasible
+    }
+    const double ce = c[e];
+    for (int j = 0; j < 4; ++j) c[j] = j == e ? -ce / p : c[j] - ce * at(r, j);
+    std::swap(B[r], N[e]);
+  }
+  return out;
+}
+
+std::vector<Affine> vertex_frames(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
+                                  const std::vector<std::uint8_t>* fixed, const std::vector<std::uint8_t>* skip,
+                                  std::vector<Index>* hex_of) {
+  std::vector<Affine> out;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const Index h = inc.ids[i];
+    if (skip && (*skip)[h]) continue;
+    const Hex& hx = mesh.hexes[h];
+    const auto p = mesh.corners(h);
+    int k = 0;
+    while (hx[k] != v) ++k;
+    const double il = inv_len[h];
+    for (int t = 0; t < kFrames; ++t) {
+      const Vec3& c = frame_coefficient(t, k);
+      if (c.isZero()) continue;
+      if (fixed) {
+        bool alone = true;
+        for (int j = 0; j < 8; ++j)
+          if (j != k && !frame_coefficient(t, j).isZero() && !(*fixed)[hx[j]]) alone = false;
+        if (!alone) continue;
+      }
+      const Mat3 A = frame(p, t, il);
+      Affine a;
+      a.b = A.determinant();
+      // d det(A + il·d cᵀ)/dd = il·adj(A)ᵀ c, written with the cross products of A's columns.
+      a.a = il * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) + c[2] * A.col(0).cross(A.col(1)));
+      out.push_back(a);
+      if (hex_of) hex_of->push_back(h);
+    }
+  }
+  return out;
+}
+
+std::size_t max_min_sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc,
+                          const std::vector<double>& inv_len, const std::vector<std::uint8_t>& active,
+                          const std::vector<std::uint8_t>* skip) {
+  std::size_t moves = 0;
+  std::vector<std::uint8_t> moved;
+  for (const std::vector<Index>& color : coloring.colors) {
+    moved.assign(color.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, color.size(), 16), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const Index v = color[i];
+        if (!active[v]) continue;
+        const std::vector<Affine> f = vertex_frames(mesh, inc, inv_len, v, nullptr, skip);
+        if (f.empty()) continue;
+        double now = f[0].b;
+        for (const Affine& a : f) now = std::min(now, a.b);
+        // Half an edge: the determinants are exactly affine in v, but the other terms of the
+        // later stages are not, and a long jump would trade shape for a tiny gain.
+        const MaxMin r = max_min_affine(f, std::vector<double>(f.size(), 1.0), 0.5 * mean_edge_at(mesh, inc, v));
+        if (!r.ok || !(r.s > now + 1e-12)) continue;
+        const Vec3 old = mesh.points[v];
+        mesh.points[v] = old + r.d;
+        // Re-evaluated rather than trusted: rounding must not turn the move into a loss.
+        double after = 1e300;
+        for (const Affine& a : vertex_frames(mesh, inc, inv_len, v, nullptr, skip)) after = std::min(after, a.b);
+        if (after > now) moved[i] = 1;
+        else mesh.points[v] = old;
+      }
+    });
+    for (std::uint8_t m : moved) moves += m;
+  }
+  return moves;
+}
+
+double mean_edge_at(const HexMesh& mesh, const Incidence& inc, Index v) {
+  double sum = 0;
+  int n = 0;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+    for (const auto& e : kHexEdges) {
+      const Hex& hx = mesh.hexes[inc.ids[i]];
+      if (hx[e[0]] != v && hx[e[1]] != v) continue;
+      sum += (mesh.points[hx[e[0]]] - mesh.points[hx[e[1]]]).norm();
+      ++n;
+    }
+  return n ? sum / n : 0.0;
+}
+
+}  // namespace isohex::opt

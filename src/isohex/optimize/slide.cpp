@@ -1,0 +1,159 @@
+// The original boundary surface, its feature edges, and nearest-point projection onto it.
+#include "isohex/optimize/slide.hpp"
+
+#include "isohex/mesh/topology.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+
+namespace isohex {
+
+namespace {
+
+// The point of triangle (a, b, c) nearest to p: by the Voronoi regions of its vertices and
+// edges (the barycentric coordinates of p's projection decide which region holds it).
+Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const double denom = 1 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+}  // namespace
+
+BoundarySurface::BoundarySurface(const HexMesh& mesh, double feature_degrees) {
+  const std::vector<Quad> quads = boundary_quads(mesh);
+  role_.assign(mesh.points.size(), static_cast<std::uint8_t>(Role::interior));
+  std::vector<Vec3> qn(quads.size());
+  std::map<std::pair<Index, Index>, std::vector<std::size_t>> edge_quads;
+  double edge_sum = 0;
+  for (std::size_t q = 0; q < quads.size(); ++q) {
+    const Quad& Q = quads[q];
+    const auto P = [&](int i) -> const Vec3& { return mesh.points[Q[i]]; };
+    const Vec3 n = (P(2) - P(0)).cross(P(3) - P(1));
+    qn[q] = n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero();
+    for (int i = 0; i < 4; ++i) {
+      const Index a = Q[i], b = Q[(i + 1) % 4];
+      edge_quads[{std::min(a, b), std::max(a, b)}].push_back(q);
+      edge_sum += (P((i + 1) % 4) - P(i)).norm();
+      role_[a] = static_cast<std::uint8_t>(Role::slides);
+    }
+    for (const auto& t : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+      tris_.push_back({P(t[0]), P(t[1]), P(t[2])});
+      const Vec3 tn = (P(t[1]) - P(t[0])).cross(P(t[2]) - P(t[0]));
+      normals_.push_back(tn.norm() > 0 ? Vec3(tn.normalized()) : qn[q]);
+    }
+  }
+  // Feature edges: a crease sharper than the threshold, or not exactly two boundary quads
+  // (a non-manifold or open boundary). Their vertices are pinned: a vertex sliding across a
+  // crease would cut the corner off the domain.
+  const double cos_limit = std::cos(feature_degrees * std::numbers::pi / 180.0);
+  for (const auto& [e, qs] : edge_quads)
+    if (qs.size() != 2 || qn[qs[0]].dot(qn[qs[1]]) < cos_limit)
+      role_[e.first] = role_[e.second] = static_cast<std::uint8_t>(Role::pinned);
+  for (std::uint8_t r : role_) {
+    sliding_ += r == static_cast<std::uint8_t>(Role::slides);
+    pinned_ += r == static_cast<std::uint8_t>(Role::pinned);
+  }
+  if (tris_.empty()) return;
+
+  // The grid: cells about one boundary edge long (capped at ~2 M cells).
+  lo_ = hi_ = tris_[0][0];
+  for (const auto& t : tris_)
+    for (const Vec3& p : t) {
+      lo_ = lo_.cwiseMin(p);
+      hi_ = hi_.cwiseMax(p);
+    }
+  cell_ = std::max(edge_sum / (4.0 * static_cast<double>(quads.size())), 1e-300);
+  const Vec3 ext = hi_ - lo_;
+  while ((ext[0] / cell_ + 1) * (ext[1] / cell_ + 1) * (ext[2] / cell_ + 1) > 2e6) cell_ *= 2;
+  for (int j = 0; j < 3; ++j) dims_[j] = static_cast<int>(ext[j] / cell_) + 1;
+  const auto cell_of = [&](const Vec3& p, int j) {
+    return std::clamp(static_cast<int>((p[j] - lo_[j]) / cell_), 0, dims_[j] - 1);
+  };
+  const std::size_t ncell = static_cast<std::size_t>(dims_[0]) * dims_[1] * dims_[2];
+  start_.assign(ncell + 1, 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t t = 0; t < tris_.size(); ++t) {
+      Vec3 a = tris_[t][0], b = a;
+      for (const Vec3& p : tris_[t]) {
+        a = a.cwiseMin(p);
+        b = b.cwiseMax(p);
+      }
+      for (int z = cell_of(a, 2); z <= cell_of(b, 2); ++z)
+        for (int y = cell_of(a, 1); y <= cell_of(b, 1); ++y)
+          for (int x = cell_of(a, 0); x <= cell_of(b, 0); ++x) {
+            const std::size_t c = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + x;
+            if (pass == 0) ++start_[c + 1];
+            else items_[fill[c]++] = static_cast<std::uint32_t>(t);
+          }
+    }
+    if (pass == 0) {
+      for (std::size_t c = 0; c < ncell; ++c) start_[c + 1] += start_[c];
+      items_.resize(start_.back());
+    }
+  }
+}
+
+std::vector<std::uint8_t> BoundarySurface::fixed_mask() const {
+  std::vector<std::uint8_t> f(role_.size(), 0);
+  for (std::size_t v = 0; v < role_.size(); ++v) f[v] = role_[v] == static_cast<std::uint8_t>(Role::pinned);
+  return f;
+}
+
+Vec3 BoundarySurface::project(const Vec3& x, const Vec3* facing, Vec3* normal) const {
+  Vec3 best = x;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  std::size_t best_t = tris_.size();
+  if (tris_.empty()) return x;
+  int c[3];
+  for (int j = 0; j < 3; ++j) c[j] = std::clamp(static_cast<int>(std::floor((x[j] - lo_[j]) / cell_)), 0, dims_[j] - 1);
+  // Rings of cells around x's cell: every triangle point within k cells of x (less x's distance
+  // outside the grid) lies in ring k or inside it, so once the best distance is that small the
+  // search is exact.
+  const double outside = (x - x.cwiseMax(lo_).cwiseMin(hi_)).norm();
+  const int kmax = std::max({dims_[0], dims_[1], dims_[2]});
+  for (int k = 0; k <= kmax; ++k) {
+    for (int z = std::max(c[2] - k, 0); z <= std::min(c[2] + k, dims_[2] - 1); ++z)
+      for (int y = std::max(c[1] - k, 0); y <= std::min(c[1] + k, dims_[1] - 1); ++y)
+        for (int xx = std::max(c[0] - k, 0); xx <= std::min(c[0] + k, dims_[0] - 1); ++xx) {
+          // Only the shell of ring k: the inside was searched before.
+          if (std::max({std::abs(z - c[2]), std::abs(y - c[1]), std::abs(xx - c[0])}) != k) continue;
+          const std::size_t cell = (static_cast<std::size_t>(z) * dims_[1] + y) * dims_[0] + xx;
+          for (std::size_t i = start_[cell]; i < start_[cell + 1]; ++i) {
+            const std::size_t t = items_[i];
+            if (facing && !(normals_[t].dot(*facing) > 0)) continue;
+            const Vec3 p = closest_on_triangle(x, tris_[t][0], tris_[t][1], tris_[t][2]);
+            const double d2 = (p - x).squaredNorm();
+            if (d2 < best_d2 || (d2 == best_d2 && t < best_t)) {
+              best_d2 = d2;
+              best = p;
+              best_t = t;
+            }
+          }
+        }
+    const double reach = k * cell_ - outside;
+    if (best_t < tris_.size() && reach > 0 && best_d2 <= reach * reach) break;
+  }
+  if (normal && best_t < tris_.size()) *normal = normals_[best_t];
+  return best;
+}
+
+}  // namespace isohex

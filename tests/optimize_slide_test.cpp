@@ -1,0 +1,173 @@
+// Boundary sliding (--boundary slide): vertices stay on the original surface, features stay
+// put, quality beats a fixed boundary, no hex is inverted, the same bits for 1 and 2 threads.
+#include "isohex/io/mesh_io.hpp"
+#include "isohex/mesh/generate.hpp"
+#include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/optimize.hpp"
+#include "isohex/optimize/slide.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <fstream>
+
+using namespace isohex;
+using isohex::test::quote;
+using isohex::test::run_cli;
+using isohex::test::scratch_dir;
+
+namespace {
+
+// A unit box whose vertices are jittered within their own face / edge / the interior: the
+// boundary surface is still the cube, but the boundary vertices sit badly on it.
+HexMesh slid_box(int n, double amplitude, unsigned seed) {
+  HexMesh m = box_mesh(n, n, n);
+  HexMesh j = m;
+  jitter(j, amplitude / n, seed);
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    for (int a = 0; a < 3; ++a)
+      if (m.points[v][a] != 0 && m.points[v][a] != 1) m.points[v][a] = j.points[v][a];
+  return m;
+}
+
+struct Outcome {
+  HexMesh mesh;
+  double objective = 0, min_sj = 0;
+  std::size_t inverted = 0;
+};
+
+// Shape stage then the worst pass, with the boundary fixed or sliding.
+Outcome optimise(const HexMesh& in, bool slide, int threads = 2) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  Outcome r{in};
+  const BoundarySurface surface(in);
+  const std::vector<std::uint8_t> fixed = slide ? surface.fixed_mask() : fixed_mask(in, FixedVertices::boundary);
+  ShapeOptions so;
+  so.surface = slide ? &surface : nullptr;
+  optimize_shape(r.mesh, fixed, so);
+  WorstOptions wo;
+  wo.surface = so.surface;
+  improve_worst(r.mesh, fixed, wo);
+  r.objective = shape_objective(r.mesh);
+  r.min_sj = 1;
+  for (double q : scaled_jacobians(r.mesh)) {
+    r.min_sj = std::min(r.min_sj, is_degenerate(q) ? -1.0 : q);
+    r.inverted += q <= 0 || is_degenerate(q);
+  }
+  return r;
+}
+
+// Distance from p to triangle (a, b, c), written independently of slide.cpp: the plane
+// projection if it falls inside, else the nearest of the three edges.
+double tri_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 n = (b - a).cross(c - a);
+  const Vec3 q = p - n * (n.dot(p - a) / n.squaredNorm());
+  const double s0 = n.dot((b - q).cross(c - q)), s1 = n.dot((c - q).cross(a - q)), s2 = n.dot((a - q).cross(b - q));
+  if (s0 >= 0 && s1 >= 0 && s2 >= 0) return (p - q).norm();
+  const auto seg = [&](const Vec3& u, const Vec3& w) {
+    const double t = std::clamp((p - u).dot(w - u) / (w - u).squaredNorm(), 0.0, 1.0);
+    return (p - (u + t * (w - u))).norm();
+  };
+  return std::min({seg(a, b), seg(b, c), seg(c, a)});
+}
+
+}  // namespace
+
+TEST(OptimizeSlide, BoxFeaturesArePinnedAndFaceVerticesStayOnTheirFaces) {
+  const int n = 6;
+  const HexMesh in = slid_box(n, 0.45, 3);
+  const BoundarySurface surface(in);
+  EXPECT_EQ(surface.num_pinned(), 12u * (n - 1) + 8u);  // the cube's edges and corners (90° creases)
+  EXPECT_EQ(surface.num_sliding(), 6u * (n - 1) * (n - 1));
+  const Outcome fixed = optimise(in, false), slide = optimise(in, true);
+  EXPECT_EQ(slide.inverted, 0u);
+  for (std::size_t v = 0; v < in.points.size(); ++v) {
+    const auto role = surface.role(static_cast<Index>(v));
+    if (role == BoundarySurface::Role::pinned) ASSERT_EQ(slide.mesh.points[v], in.points[v]) << v;
+    if (role != BoundarySurface::Role::slides) continue;
+    // A face vertex keeps the coordinate that puts it on its face, to the last bit.
+    int on = 0;
+    for (int a = 0; a < 3; ++a)
+      if (in.points[v][a] == 0 || in.points[v][a] == 1) {
+        ASSERT_EQ(slide.mesh.points[v][a], in.points[v][a]) << v;
+        ++on;
+      }
+    EXPECT_EQ(on, 1) << v;
+  }
+  // Sliding lets the badly placed face vertices move: better than the fixed boundary.
+  EXPECT_LT(slide.objective, fixed.objective - 1e-3);
+  EXPECT_GT(slide.min_sj, fixed.min_sj + 0.02);
+}
+
+TEST(OptimizeSlide, BallVerticesStayOnTheOriginalSurface) {
+  const HexMesh in = ball_mesh(6);
+  const BoundarySurface surface(in);
+  EXPECT_EQ(surface.num_pinned(), 0u);  // a sphere has no crease sharper than 30°
+  const Outcome fixed = optimise(in, false), slide = optimise(in, true);
+  EXPECT_EQ(slide.inverted, 0u);
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < in.points.size(); ++v) {
+    if (surface.role(static_cast<Index>(v)) != BoundarySurface::Role::slides) continue;
+    moved += slide.mesh.points[v] != in.points[v];
+    double d = 1e300;
+    for (const auto& t : surface.triangles()) d = std::min(d, tri_distance(slide.mesh.points[v], t[0], t[1], t[2]));
+    ASSERT_LE(d, 1e-12) << v;
+  }
+  EXPECT_GT(moved, 50u);
+  EXPECT_GT(slide.min_sj, fixed.min_sj);
+  EXPECT_LT(slide.objective, fixed.objective);
+}
+
+TEST(OptimizeSlide, OneAndTwoThreadsGiveTheSameBits) {
+  HexMesh in = slid_box(5, 0.4, 8);
+  // Tangle the interior too, so the untangler's sliding and LP paths run as well.
+  HexMesh j = in;
+  jitter(j, 0.9 / 5, 9);
+  const auto boundary = boundary_vertex_mask(in);
+  for (std::size_t v = 0; v < in.points.size(); ++v)
+    if (!boundary[v]) in.points[v] = j.points[v];
+  std::size_t tangled = 0;
+  for (double q : scaled_jacobians(in)) tangled += q <= 0;
+  ASSERT_GT(tangled, 5u);
+  std::vector<Vec3> out[2];
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    HexMesh m = in;
+    const BoundarySurface surface(in);
+    const auto fixed = surface.fixed_mask();
+    UntangleOptions uo;
+    uo.surface = &surface;
+    const UntangleResult u = untangle(m, fixed, uo);
+    EXPECT_EQ(u.inverted, 0u);
+    ShapeOptions so;
+    so.surface = &surface;
+    optimize_shape(m, fixed, so);
+    WorstOptions wo;
+    wo.surface = &surface;
+    improve_worst(m, fixed, wo);
+    out[threads - 1] = m.points;
+  }
+  EXPECT_EQ(out[0], out[1]);
+}
+
+TEST(OptimizeSlide, CliSlidesAndRefusesOtherFixedModes) {
+  const auto dir = scratch_dir();
+  io::write_mesh(dir / "in.vtk", slid_box(5, 0.8, 4));
+  std::string out;
+  ASSERT_EQ(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "out.vtk") + " --boundary slide --json " +
+                        quote(dir / "r.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("slide"), std::string::npos) << out;
+  std::ifstream json(dir / "r.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"max_distance\""), std::string::npos) << text;
+  // Sliding moves the boundary: it cannot be combined with a mask that fixes other vertices.
+  EXPECT_NE(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "x.vtk") + " --boundary slide --fixed none", &out), 0);
+  EXPECT_NE(out.find("--fixed"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.vtk"));
+}
