@@ -1,6 +1,9 @@
-// isohex mesh VOLUME --iso V -o OUT: the uniform dual-contouring hex mesh of a volume (or of a
-// shape expression), with its quality summary and its distance to the isosurface.
+// isohex mesh VOLUME --iso V -o OUT: the hex mesh of a volume (or of a shape expression), from
+// extraction to verification: dual contouring, surface smoothing, boundary pillowing,
+// untangling + mean-ratio optimisation, then validation, the distance to the isosurface and a
+// per-stage quality table.
 #include "commands.hpp"
+#include "mesh_stages.hpp"
 
 #include "isohex/contour/dual_contour.hpp"
 #include "isohex/error.hpp"
@@ -25,7 +28,7 @@ namespace isohex::cli {
 namespace {
 
 struct Args {
-  std::string volume, shape, output, json;
+  std::string volume, shape, output, json, report;
   std::optional<double> iso, iso2;
   std::string inside = "above", interpolation = "trilinear", region = "inside", outer;
   double cell_size = 0;
@@ -35,7 +38,7 @@ struct Args {
   std::string type, endian = "little";
   std::vector<double> spacing, origin;
   std::size_t header_bytes = 0;
-  bool no_surface_smoothing = false;
+  bool no_surface_smoothing = false, no_pillow = false, no_smooth = false;
   int surface_iterations = 30;
   int* threads = nullptr;
 };
@@ -70,7 +73,7 @@ Volume sample_shape(const Args& a, double& cell_size) {
 // Smooths the boundary on each isosurface of the region in turn. Vertices of the other
 // surfaces and of the domain box are pinned, so each surface keeps its own vertices on it.
 std::vector<SurfaceSmoothingReport> smooth_surfaces(const contour::Region& region, contour::ExtractResult& out,
-                                                    int iterations, bool terminal) {
+                                                    int iterations, bool guard_hexes, bool terminal) {
   std::vector<SurfaceSmoothingReport> reports;
   for (std::size_t k = 0; k < region.surfaces.size(); ++k) {
     const IsoField* field = region.surfaces[k].field();
@@ -81,6 +84,8 @@ std::vector<SurfaceSmoothingReport> smooth_surfaces(const contour::Region& regio
     if (terminal) fmt::print("  surface smoothing on {}...\n", region.surfaces[k].describe()), std::fflush(stdout);
     SurfaceSmoothingOptions opt;
     opt.iterations = iterations;
+    opt.guard_hexes = guard_hexes;
+    if (!guard_hexes) opt.interior_layers = 0;  // the hexes below are re-shaped after pillowing
     opt.pinned.assign(out.mesh.points.size(), 0);
     for (std::size_t v = 0; v < out.vertex_place.size(); ++v) {
       const std::int8_t place = out.vertex_place[v];
@@ -171,11 +176,40 @@ void run(const Args& a) {
   fmt::print("grid {} x {} x {} points, cell size {:.6g}\n", r.grid.points[0], r.grid.points[1], r.grid.points[2],
              r.grid.h);
 
+  std::vector<StageRow> rows;
+  rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes));
   auto t = Clock::now();
   const std::vector<SurfaceSmoothingReport> smoothing =
-      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations, terminal);
+      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations, a.no_pillow, terminal);
   const double smooth_time = seconds_since(t);
   for (std::size_t k = 0; k < smoothing.size(); ++k) print_smoothing(region.surfaces[k], smoothing[k]);
+  if (!a.no_surface_smoothing) {
+    rows.push_back(stage_row("surface smoothing", out.mesh, smooth_time));
+    for (std::size_t k = 0; k < smoothing.size(); ++k) {
+      const SurfaceSmoothingReport& sr = smoothing[k];
+      if (!region.surfaces[k].field()) continue;
+      rows.back().extra[region.surfaces[k].describe()] =
+          fmt::format("{} iterations; boundary quads < 0.2: {} -> {}, min quad SJ {:.3g} -> {:.3g}", sr.iterations,
+                      sr.before.quads_below, sr.after.quads_below, sr.before.quad_sj_min, sr.after.quad_sj_min);
+    }
+  }
+
+  nlohmann::json pillowing, optimisation;
+  if (!a.no_pillow) {
+    t = Clock::now();
+    pillowing = pillow_stage(out.mesh, out.vertex_place, terminal);
+    rows.push_back(stage_row("pillowing", out.mesh, seconds_since(t)));
+    rows.back().extra = pillowing;
+  }
+  std::size_t inverted_left = 0;
+  if (!a.no_smooth) {
+    t = Clock::now();
+    optimisation = optimise_stage(out.mesh, terminal, inverted_left);
+    rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t)));
+    rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
+                         {"shape sweeps", optimisation["shape"]["iterations"]},
+                         {"worst moves", optimisation["worst"]["moves"]}};
+  }
 
   t = Clock::now();
   const ValidationReport check = validate(out.mesh);
@@ -207,8 +241,12 @@ void run(const Args& a) {
              "{:.3f} s, surface smoothing {:.3f} s, check {:.3f} s, write {:.3f} s\n",
              read_time, r.time_sample, r.time_repair, r.time_components, r.time_vertices, r.time_hexes, smooth_time,
              check_time, write_time);
+  print_stage_table(rows);
+  const double peak = peak_memory_mib();
+  fmt::print("boundary distance to the isosurface: max |f - iso| / range {:.3g}; total {:.2f} s; peak memory {:.0f} MiB\n",
+             dist.max_relative, seconds_since(start), peak);
 
-  if (!a.json.empty()) {
+  if (!a.json.empty() || !a.report.empty()) {
     nlohmann::json j;
     j["input"] = a.shape.empty() ? a.volume : a.shape;
     j["region"] = a.region;
@@ -249,16 +287,30 @@ void run(const Args& a) {
     nlohmann::json sm = nlohmann::json::array();
     for (std::size_t k = 0; k < smoothing.size(); ++k) sm.push_back(smoothing_json(region.surfaces[k], smoothing[k]));
     j["surface_smoothing"] = sm;
-    write_json(a.json, j);
+    j["stages"] = stage_table_json(rows);
+    if (!a.no_pillow) j["pillowing"] = pillowing;
+    if (!a.no_smooth) j["optimisation"] = optimisation;
+    j["peak_memory_mib"] = peak;
+    j["seconds"] = seconds_since(start);
+    if (!a.json.empty()) write_json(a.json, j);
+    if (!a.report.empty()) {
+      if (terminal) fmt::print("  writing the report...\n"), std::fflush(stdout);
+      j.erase("repair_edits");  // in --json; too long for a page
+      write_mesh_report(a.report, fmt::format("isohex mesh: {}", a.shape.empty() ? a.volume : a.shape), rows, j, out.mesh);
+      fmt::print("report: {}/report.html\n", a.report);
+    }
   }
-  if (!check.valid() || dist.off_surface > 0) exit_code() = 1;
+  // A mesh a solver would refuse fails the run (it is written all the same, for inspection).
+  if (!check.valid() || dist.off_surface > 0 || inverted_left > 0) exit_code() = 1;
 }
 
 }  // namespace
 
 void register_mesh(CLI::App& app) {
   auto a = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand("mesh", "Uniform dual-contouring hex mesh of a volume's isosurface region");
+  CLI::App* cmd = app.add_subcommand("mesh", "Hex mesh of a volume's isosurface region: dual-contouring extraction, surface "
+                                             "smoothing, boundary pillowing, untangling and mean-ratio optimisation, "
+                                             "verification");
   cmd->add_option("volume", a->volume, "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)");
   cmd->add_option("--shape", a->shape, "Mesh an implicit shape expression instead (inside where its distance < ISO, default 0)");
   cmd->add_option("--iso", a->iso, "Isovalue");
@@ -281,8 +333,15 @@ void register_mesh(CLI::App& app) {
                 "Skip the geometric-flow smoothing of the boundary quads (on by default; vertices stay on the isosurface)");
   cmd->add_option("--surface-iterations", a->surface_iterations, "Iterations of the surface smoothing (default 30)")
       ->check(CLI::Range(0, 10000));
+  cmd->add_flag("--no-pillow", a->no_pillow,
+                "Skip boundary pillowing (on by default: a sheet of hexes inside the boundary, surface unchanged)");
+  cmd->add_flag("--no-smooth", a->no_smooth,
+                "Skip untangling and mean-ratio optimisation (on by default; boundary vertices fixed)");
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
+  cmd->add_option("--report", a->report,
+                  "Write a report folder: report.json, quality histograms per stage (SVG, PNG), report.html with a 3D "
+                  "cut-away view coloured by scaled Jacobian");
   cmd->add_option("--dims", a->dims, "Raw files: grid points along x, y, z")->expected(3);
   cmd->add_option("--type", a->type, "Raw files: the stored value type")
       ->check(CLI::IsMember({"u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"}));

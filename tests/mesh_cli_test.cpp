@@ -1,11 +1,15 @@
-// isohex mesh end to end: extraction followed by the surface smoothing stage.
+// isohex mesh end to end: extraction, surface smoothing, and the whole pipeline.
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
+#include "isohex/mesh/topology.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/volume/implicit.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <algorithm>
+#include <array>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 using namespace isohex;
@@ -17,12 +21,12 @@ TEST(MeshCli, SurfaceSmoothingImprovesTheBoundaryAndKeepsItOnTheSurface) {
   const auto dir = scratch_dir();
   const std::string shape = "'union(sphere(0,0,0,1), torus(0,0,0.6, 1.1, 0.35))'";
   std::string out;
-  ASSERT_EQ(run_cli("mesh --shape " + shape + " --resolution 14 --no-surface-smoothing -o " + q(dir / "raw.vtu") +
+  ASSERT_EQ(run_cli("mesh --shape " + shape + " --resolution 14 --no-surface-smoothing --no-pillow --no-smooth -o " + q(dir / "raw.vtu") +
                         " --json " + q(dir / "raw.json"),
                     &out),
             0)
       << out;
-  ASSERT_EQ(run_cli("mesh --shape " + shape + " --resolution 14 -o " + q(dir / "smooth.vtu") + " --json " +
+  ASSERT_EQ(run_cli("mesh --shape " + shape + " --resolution 14 --no-pillow --no-smooth -o " + q(dir / "smooth.vtu") + " --json " +
                         q(dir / "smooth.json"),
                     &out),
             0)
@@ -56,4 +60,51 @@ TEST(MeshCli, SmoothingIsDeterministicAcrossThreadCounts) {
                       q(dir / ("t" + std::to_string(t) + ".vtu"))),
               0);
   EXPECT_EQ(io::read_file(dir / "t1.vtu"), io::read_file(dir / "t2.vtu"));
+}
+
+// The whole pipeline on a ball: every stage reported, the pillow adds one hex per boundary
+// quad, nothing is left inverted or below 0.2, the boundary stays on the isosurface and is
+// the pillowed mesh's boundary, bit for bit (the optimiser holds it fixed).
+TEST(MeshCli, PipelineRunsEveryStageAndKeepsTheBoundary) {
+  const auto dir = scratch_dir();
+  std::string out;
+  const std::string shape = "'sphere(0,0,0,1)'";
+  ASSERT_EQ(run_cli("mesh --shape " + shape + " --resolution 10 --no-smooth -o " + q(dir / "s.vtu") +
+                        " --json " + q(dir / "s.json"),
+                    &out),
+            0)
+      << out;
+  ASSERT_EQ(run_cli("mesh --shape " + shape + " --resolution 10 -o " + q(dir / "p.vtu") + " --json " + q(dir / "p.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("optimisation"), std::string::npos) << out;  // the summary table
+  const auto s = nlohmann::json::parse(io::read_file(dir / "s.json"));
+  const auto p = nlohmann::json::parse(io::read_file(dir / "p.json"));
+  ASSERT_EQ(p["stages"].size(), 4u);
+  const char* names[] = {"extraction", "surface smoothing", "pillowing", "optimisation"};
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(p["stages"][i]["stage"], names[i]);
+  EXPECT_EQ(p["stages"][2]["hexes"].get<Index>(), p["stages"][0]["hexes"].get<Index>() + p["boundary_quads"].get<Index>());
+  EXPECT_EQ(s["hexes"], p["hexes"]);
+  EXPECT_EQ(p["stages"][3]["scaled_jacobian"]["inverted"], 0);
+  EXPECT_EQ(p["scaled_jacobian"]["inverted"], 0);
+  EXPECT_EQ(p["stages"][3]["below_0.2"], 0);
+  EXPECT_GT(p["scaled_jacobian"]["min"].get<double>(), s["scaled_jacobian"]["min"].get<double>());
+  EXPECT_TRUE(p["valid"].get<bool>());
+  EXPECT_EQ(p["off_surface_vertices"], 0);
+  EXPECT_GT(p["peak_memory_mib"].get<double>(), 0);
+  // Boundary of the pipeline's mesh = boundary of the pillowed mesh.
+  const HexMesh a = io::read_mesh(dir / "s.vtu"), b = io::read_mesh(dir / "p.vtu");
+  auto surface = [](const HexMesh& m) {
+    std::vector<std::array<double, 12>> quads;
+    for (const Quad& qd : boundary_quads(m)) {
+      std::array<double, 12> c{};
+      for (int k = 0; k < 4; ++k)
+        for (int d = 0; d < 3; ++d) c[static_cast<std::size_t>(3 * k + d)] = m.points[qd[k]][d];
+      quads.push_back(c);
+    }
+    std::sort(quads.begin(), quads.end());
+    return quads;
+  };
+  EXPECT_EQ(surface(a), surface(b));
 }

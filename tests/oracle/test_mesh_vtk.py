@@ -233,7 +233,7 @@ def main():
             continue
         out = os.path.join(args.tmp, name + ".vtu")
         rep = os.path.join(args.tmp, name + ".json")
-        run = subprocess.run([args.cli, "mesh", path, "--no-surface-smoothing", "--iso", str(iso), "--cell-size", str(h), "-o", out, "--json", rep]
+        run = subprocess.run([args.cli, "mesh", path, "--no-surface-smoothing", "--no-pillow", "--no-smooth", "--iso", str(iso), "--cell-size", str(h), "-o", out, "--json", rep]
                              + raw_args, capture_output=True, text=True)
         if run.returncode != 0:
             failures.append(f"{name}: isohex mesh exit {run.returncode}: {run.stdout[-800:]} {run.stderr}")

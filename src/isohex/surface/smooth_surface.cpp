@@ -173,8 +173,16 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
   const double mean_edge = edge_count > 0 ? edge_sum / static_cast<double>(edge_count) : 0.0;
 
   // The projection phase's hard floors: no new inverted hex or boundary quad.
-  MoveContext ctx{mesh, graph, field, options.min_hex_sj, options.min_quad_sj, 0.0, options.max_halvings,
-                  options.level_tolerance * field.value_range(), options.projection_reach};
+  MoveContext ctx{mesh,
+                  graph,
+                  field,
+                  options.min_hex_sj,
+                  options.min_quad_sj,
+                  0.0,
+                  options.max_halvings,
+                  options.level_tolerance * field.value_range(),
+                  options.projection_reach,
+                  options.guard_hexes};
   const std::vector<Vec3> start = mesh.points;
   std::vector<double> curvature(static_cast<std::size_t>(nv), 0.0);
   std::vector<MoveOutcome> outcome(static_cast<std::size_t>(nv), MoveOutcome::none);

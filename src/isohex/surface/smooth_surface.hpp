@@ -72,6 +72,10 @@ struct SurfaceSmoothingOptions {
   double level_tolerance = 1e-7;      ///< projection target |L| ≤ this × the field's value range, in (0, 1e-6]
   double projection_reach = 1.0;      ///< largest projection distance, × the vertex's mean boundary edge length
   double convergence = 1e-4;          ///< stop once no vertex moved more than this × the mean boundary edge length
+  /// Check the hexes as well as the boundary quads. Off when a boundary pillow follows: the
+  /// pillow gives every boundary quad a new hex and the hexes below are re-shaped anyway,
+  /// so only the surface's own quality matters, and the hexes' floors would block it.
+  bool guard_hexes = true;
   bool use_mesh_fixed = true;         ///< treat `mesh.fixed` as pinned
   std::vector<std::uint8_t> pinned;   ///< optional mask, one per vertex: 1 = pinned (e.g. on a volume-box face)
 };

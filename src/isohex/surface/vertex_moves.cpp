@@ -132,7 +132,7 @@ bool move_is_acceptable(const MoveContext& ctx, Index v, const Vec3& y, bool bou
   const bool relax = check == Check::relax;
   const double hex_soft = relax ? ctx.hex_floor : 0.0;
   const auto& vh = ctx.graph.vertex_hexes;
-  for (Index k = vh.offsets[v]; k < vh.offsets[v + 1]; ++k) {
+  for (Index k = ctx.guard_hexes ? vh.offsets[v] : vh.offsets[v + 1]; k < vh.offsets[v + 1]; ++k) {
     const Index h = vh.ids[k];
     const double after = hex_sj(mesh, h, v, y);
     if (after >= hex_soft) continue;  // the common case: no need for the old value

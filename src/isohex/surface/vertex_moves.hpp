@@ -35,6 +35,7 @@ struct MoveContext {
   int max_halvings;
   double level_tolerance;  ///< absolute |L| a projection aims for
   double projection_reach; ///< × the mean boundary edge length at the vertex
+  bool guard_hexes = true;  ///< false: only the boundary quads are checked (a pillow follows)
 };
 
 /// Outward unit normal of the isosurface at boundary vertex `v` (−∇L normalised; the

@@ -1,0 +1,50 @@
+#pragma once
+// The stages `isohex mesh` runs after extraction and surface smoothing: boundary pillowing,
+// untangling + shape optimisation with the boundary fixed, and the per-stage summary table.
+
+#include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/quality/summary.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace isohex::cli {
+
+/// One row of the summary table: the mesh as a stage left it.
+struct StageRow {
+  std::string name;
+  Index hexes = 0, vertices = 0;
+  std::vector<double> sj_values;  ///< per hex (for the report's histograms)
+  MetricSummary sj;
+  double seconds = 0;
+  nlohmann::json extra = nlohmann::json::object();  ///< the stage's facts
+};
+
+/// Summarises `mesh` (scaled Jacobians computed here) as the row of stage `name`.
+StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds);
+
+/// Boundary pillowing: one sheet of hexes inside the whole boundary, the surface kept as it is.
+/// `vertex_place` (one entry per vertex, see contour::ExtractResult) grows with the new
+/// vertices, which are interior. Returns the JSON facts of the stage.
+nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, bool terminal);
+
+/// Untangling, inverse-mean-ratio optimisation and the worst-element pass with the boundary
+/// fixed. Returns the JSON facts of the stage; `inverted_left` is set to the hexes still
+/// inverted.
+nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left);
+
+/// Prints the table of rows (hexes, vertices, min/mean SJ, #<0, #<0.2, time).
+void print_stage_table(const std::vector<StageRow>& rows);
+nlohmann::json stage_table_json(const std::vector<StageRow>& rows);
+
+/// Writes the report folder (report.json, histograms, report.html with the 3D view of `mesh`).
+void write_mesh_report(const std::string& dir, const std::string& title, const std::vector<StageRow>& rows,
+                       const nlohmann::json& summary, const HexMesh& mesh);
+
+/// Peak resident memory of this process so far, in MiB.
+double peak_memory_mib();
+
+}  // namespace isohex::cli
