@@ -380,10 +380,16 @@ TEST(SurfaceSmoothing, RejectsBadInput) {
   Volume constant = sphere_volume();
   std::fill(constant.values.begin(), constant.values.end(), 1.f);
   expect_error(ball, IsoField(constant, 0, Inside::below), {}, "constant field");
-  // A mesh far from the field's grid.
+  // A mesh far from the field's grid: its boundary vertices see a clamped field and are
+  // pinned, not moved.
   HexMesh far = ball;
   for (Vec3& p : far.points) p.x() += 10;
-  expect_error(far, field, {}, "outside the grid");
+  const HexMesh far_before = far;
+  const SurfaceSmoothingReport fr = smooth_surface(far, field);
+  EXPECT_EQ(fr.outside_grid, fr.boundary_vertices);
+  const std::vector<std::uint8_t> on_boundary = boundary_vertex_mask(far_before);
+  for (Index v = 0; v < far.num_vertices(); ++v)
+    if (on_boundary[v]) EXPECT_EQ(far.points[v], far_before.points[v]);
   // Broken meshes and masks.
   HexMesh bad_id = ball;
   bad_id.hexes[3][5] = bad_id.num_vertices();

@@ -70,19 +70,22 @@ void check_inputs(const HexMesh& mesh, const IsoField& field, const SurfaceSmoot
   check_range("convergence", o.convergence, 0, 1);
 }
 
-// A boundary vertex more than a cell outside the grid sees a clamped, flat field.
-void check_boundary_in_grid(const HexMesh& mesh, const std::vector<std::uint8_t>& on_boundary,
-                            const std::vector<std::uint8_t>& pinned, const Volume& vol) {
+// A boundary vertex more than a cell outside the grid sees a clamped field, constant along
+// the grid's axis there (a scan cut at the neck continues as a cylinder): it cannot slide
+// along the surface, so it is pinned. Returns how many were.
+std::size_t pin_outside_grid(const HexMesh& mesh, const std::vector<std::uint8_t>& on_boundary,
+                             std::vector<std::uint8_t>& pinned, const Volume& vol) {
   const Vec3 lo = vol.origin - vol.spacing, hi = vol.max_corner() + vol.spacing;
+  std::size_t n = 0;
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
     if (!on_boundary[v] || pinned[v]) continue;
     const Vec3& p = mesh.points[v];
-    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any())
-      throw Error(fmt::format("surface smoothing: boundary vertex {} at ({}, {}, {}) lies outside the field's grid "
-                              "[{}, {}] x [{}, {}] x [{}, {}]",
-                              v, p.x(), p.y(), p.z(), vol.origin.x(), vol.max_corner().x(), vol.origin.y(),
-                              vol.max_corner().y(), vol.origin.z(), vol.max_corner().z()));
+    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) {
+      pinned[v] = 1;
+      ++n;
+    }
   }
+  return n;
 }
 
 SurfaceQuality quality_of(const HexMesh& mesh, const std::vector<Quad>& quads) {
@@ -140,9 +143,10 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
 
   const double crease_cos = std::cos(options.crease_angle_degrees * std::numbers::pi / 180.0);
   const surface_detail::SurfaceGraph graph = surface_detail::build_surface_graph(mesh, crease_cos);
-  check_boundary_in_grid(mesh, graph.on_boundary, pinned, field.volume());
+  const std::size_t outside_grid = pin_outside_grid(mesh, graph.on_boundary, pinned, field.volume());
 
   SurfaceSmoothingReport report;
+  report.outside_grid = outside_grid;
   report.before = quality_of(mesh, graph.quads);
 
   // Free boundary vertices: sliding ones and crease ones (projection only).

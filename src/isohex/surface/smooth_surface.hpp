@@ -104,6 +104,7 @@ struct SurfaceSmoothingReport {
   double max_displacement = 0;     ///< largest distance any vertex moved, start to end
   std::size_t boundary_vertices = 0;
   std::size_t pinned_vertices = 0;     ///< pinned by mesh.fixed or options.pinned (all vertices)
+  std::size_t outside_grid = 0;        ///< boundary vertices pinned for lying over a cell outside the field's grid
   std::size_t crease_vertices = 0;     ///< unpinned boundary vertices held on a crease
   std::size_t interior_vertices = 0;   ///< interior vertices allowed to relax
   std::size_t colours = 0;             ///< colour classes used (boundary + interior)
@@ -115,8 +116,8 @@ struct SurfaceSmoothingReport {
 /// it (see the file comment). Throws isohex::Error for an empty mesh, a vertex id out of
 /// range, non-finite coordinates, masks of the wrong size, options out of range, a field
 /// whose grid is not 3-D (fewer than 2 points on an axis), whose value count does not match
-/// its dimensions or whose values are all equal, and a boundary vertex more than one grid
-/// cell outside the field's grid box.
+/// its dimensions or whose values are all equal. Boundary vertices more than one grid cell
+/// outside the field's grid box are pinned (SurfaceSmoothingReport::outside_grid).
 SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field,
                                       const SurfaceSmoothingOptions& options = {});
 
