@@ -31,13 +31,22 @@ void run(const Args& a) {
   const std::size_t multi_before = count_multi_boundary_hexes(mesh);
   const PillowResult r = pillow(mesh, set, opt);
   const std::size_t multi_after = count_multi_boundary_hexes(r.mesh);
-  const auto shrink_hexes = std::count(set.begin(), set.end(), 1);
+  const auto shrink_hexes = std::count_if(set.begin(), set.end(), [](std::uint8_t f) { return f != 0; });
   io::write_mesh(a.output, r.mesh);
 
   fmt::print("{}: {} hexes, {} vertices; shrink set '{}': {} hexes\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
              a.shrink_set, shrink_hexes);
-  fmt::print("interface: {} quads, {} vertices; pinch copies: {}; displacements reduced: {}\n", r.interface_quads,
-             r.interface_vertices, r.pinch_copies, r.reduced_vertices);
+  fmt::print("interface: {} quads, {} vertices; pinch copies: {} ({} taken by outside hexes); pinched edges: {} "
+             "({} with the shrink side merged); displacements reduced: {}\n",
+             r.interface_quads, r.interface_vertices, r.pinch_copies, r.outside_copies, r.pinched_edges,
+             r.flipped_edges, r.reduced_vertices);
+  if (!r.added.empty() || !r.removed.empty())
+    fmt::print("shrink set adjusted by +{}/-{} hexes (pinches with no valid placement)\n", r.added.size(),
+               r.removed.size());
+  if (r.folded_vertices > 0)
+    fmt::print("warning: the interface is folded at {} vertices (e.g. inverted boundary quads): {} new hexes and {} "
+               "changed hexes are inverted; untangle them (isohex smooth --untangle)\n",
+               r.folded_vertices, r.inverted_new_hexes, r.inverted_changed_hexes);
   fmt::print("new hexes: {} (min scaled Jacobian {:.4f}); result: {} hexes, {} vertices\n", r.interface_quads,
              r.min_new_scaled_jacobian, r.mesh.num_hexes(), r.mesh.num_vertices());
   fmt::print("hexes with >= 2 boundary faces: {} before, {} after\n", multi_before, multi_after);
@@ -54,6 +63,14 @@ void run(const Args& a) {
     j["interface_vertices"] = r.interface_vertices;
     j["pinch_copies"] = r.pinch_copies;
     j["reduced_vertices"] = r.reduced_vertices;
+    j["outside_copies"] = r.outside_copies;
+    j["pinched_edges"] = r.pinched_edges;
+    j["flipped_edges"] = r.flipped_edges;
+    j["shrink_set_added"] = r.added.size();
+    j["shrink_set_removed"] = r.removed.size();
+    j["folded_vertices"] = r.folded_vertices;
+    j["inverted_new_hexes"] = r.inverted_new_hexes;
+    j["inverted_changed_hexes"] = r.inverted_changed_hexes;
     j["new_hexes"] = r.interface_quads;
     j["min_new_scaled_jacobian"] = r.min_new_scaled_jacobian;
     j["hexes_before"] = mesh.num_hexes();

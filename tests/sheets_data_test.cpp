@@ -1,10 +1,13 @@
 // Boundary pillowing and the shrink-set specifications on the shared ECR 2015 meshes and via the CLI.
+#include "isohex/contour/dual_contour.hpp"
+#include "isohex/contour/region.hpp"
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/sheets/dual_sheets.hpp"
 #include "isohex/sheets/pillow.hpp"
+#include "isohex/volume/implicit.hpp"
 #include "sheets_support.hpp"
 #include "test_support.hpp"
 
@@ -125,6 +128,66 @@ TEST(PillowCli, PillowThenSheets) {
                     &out),
             2);
   EXPECT_NE(out.find("line 2: 'four' is not a hex id"), std::string::npos) << out;
+
+  {  // all but two hexes of a 2³ box touching at the centre: an outer pinch, pillowed
+    std::ofstream f(dir / "outer.txt");
+    f << "1\n2\n3\n4\n5\n6\n";
+  }
+  ASSERT_EQ(run_cli("generate box -n 2 --size 2 -o " + q(dir / "box2.vtu"), &out), 0) << out;
+  ASSERT_EQ(run_cli("pillow " + q(dir / "box2.vtu") + " -o " + q(dir / "o.vtu") + " --shrink-set ids:" +
+                        (dir / "outer.txt").string() + " --json " + q(dir / "o.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("pinch copies: 1 (2 taken by outside hexes)"), std::string::npos) << out;
+  const auto o = nlohmann::json::parse(io::read_file(dir / "o.json"));
+  EXPECT_EQ(o["hexes_after"], 8 + 6);
+  EXPECT_EQ(o["vertices_after"], 27 + 13 + 1);
+  EXPECT_EQ(o["inverted_new_hexes"], 0);
+  EXPECT_TRUE(validate(io::read_mesh(dir / "o.vtu")).valid());
+}
+
+/// The extraction's output (raw dual contouring, in process so that the test does not depend
+/// on the stages `isohex mesh` runs), pillowed via the CLI: one new sheet captures each
+/// boundary component (a ball with a cavity and a torus: three components) and no hex keeps
+/// two boundary faces.
+TEST(PillowCli, ExtractedShapeGetsOneSheetPerBoundaryComponent) {
+  const auto dir = scratch_dir();
+  const Shape shape =
+      parse_shape("difference(union(sphere(0,0,0,1), torus(3,0,0,1,0.4)), sphere(0,0,0,0.5))");
+  const double h = 0.18;
+  const Volume volume = sample(shape, grid_from_cell_size(sampling_bounds(shape), h));
+  contour::RegionSpec spec;
+  spec.isovalue = 0;
+  spec.inside = Inside::below;
+  contour::ExtractOptions opt;
+  opt.cell_size = h;
+  const HexMesh a = contour::extract_hex_mesh(contour::make_region(volume, spec), opt).mesh;
+  io::write_mesh(dir / "a.vtu", a);
+  const ValidationReport va = validate(a);
+  ASSERT_TRUE(va.valid());
+  ASSERT_EQ(va.num_boundary_components, 3u);
+
+  std::string out;
+  ASSERT_EQ(run_cli("pillow " + q(dir / "a.vtu") + " -o " + q(dir / "b.vtu") + " --json " + q(dir / "b.json"), &out), 0)
+      << out;
+  ASSERT_EQ(run_cli("sheets " + q(dir / "a.vtu") + " --json " + q(dir / "sa.json"), &out), 0) << out;
+  ASSERT_EQ(run_cli("sheets " + q(dir / "b.vtu") + " --json " + q(dir / "sb.json"), &out), 0) << out;
+  const auto b = nlohmann::json::parse(io::read_file(dir / "b.json"));
+  const auto sa = nlohmann::json::parse(io::read_file(dir / "sa.json"));
+  const auto sb = nlohmann::json::parse(io::read_file(dir / "sb.json"));
+  EXPECT_EQ(b["interface_quads"], va.num_boundary_quads);
+  EXPECT_EQ(b["hexes_after"], a.hexes.size() + va.num_boundary_quads);
+  EXPECT_GT(sa["multi_boundary_hexes"].get<int>(), 0);
+  EXPECT_EQ(sa["components_captured_by_one_sheet"], 0);
+  EXPECT_EQ(sb["components_captured_by_one_sheet"], 3);
+  EXPECT_EQ(sb["multi_boundary_hexes"], 0);
+  const HexMesh m = io::read_mesh(dir / "b.vtu");
+  const ValidationReport v = validate(m);
+  EXPECT_TRUE(v.valid());
+  EXPECT_EQ(v.num_boundary_components, 3u);
+  EXPECT_EQ(v.euler_characteristic, va.euler_characteristic);
+  EXPECT_TRUE(same_surface(a, m));
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 #include "isohex/mesh/topology.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/quality/hex_quality.hpp"
-#include "isohex/mesh/union_find.hpp"
+#include "isohex/sheets/pillow_split.hpp"
 
 #include <fmt/format.h>
 
@@ -16,25 +16,7 @@ namespace isohex {
 
 namespace {
 
-/// An interface quad, oriented counter-clockwise seen from outside its shrink-set hex (so its
-/// normal points away from the shrink set).
-struct InterfaceQuad {
-  Quad v;
-  Index shrink_hex;
-};
-
-/// A new vertex: the copy of `original` used by the shrink-set hexes of one fan.
-struct Copy {
-  Index original;
-  Vec3 displacement;       // full displacement, before halving
-  double scale = 1.0;      // halved while it inverts a hex
-  std::vector<Index> hexes;  // the shrink-set hexes of the fan
-};
-
-/// Area vector of a quad (half the cross product of its diagonals).
-Vec3 area_vector(const HexMesh& m, const Quad& q) {
-  return 0.5 * (m.points[q[2]] - m.points[q[0]]).cross(m.points[q[3]] - m.points[q[1]]);
-}
+using detail::InterfaceQuad;
 
 void require_valid(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink_set) {
   if (shrink_set.size() != mesh.hexes.size())
@@ -61,174 +43,21 @@ std::vector<InterfaceQuad> find_interface(const std::vector<QuadFace>& quads, co
   for (const QuadFace& q : quads) {
     const bool s0 = in[q.hex[0]] != 0;
     if (q.is_boundary()) {
-      if (s0 && include_boundary) out.push_back({q.vertices, q.hex[0]});
+      if (s0 && include_boundary) out.push_back({q.vertices, q.hex[0], -1});
       continue;
     }
     const bool s1 = in[q.hex[1]] != 0;
     if (s0 == s1) continue;
-    if (s0) out.push_back({q.vertices, q.hex[0]});
-    else out.push_back({{q.vertices[0], q.vertices[3], q.vertices[2], q.vertices[1]}, q.hex[1]});  // seen from hex[1]
+    if (s0) out.push_back({q.vertices, q.hex[0], q.hex[1]});
+    else  // seen from hex[1]
+      out.push_back({{q.vertices[0], q.vertices[3], q.vertices[2], q.vertices[1]}, q.hex[1], q.hex[0]});
   }
   return out;
 }
 
-/// Splits interface vertex v into one copy per fan of shrink-set hexes around it.
-class VertexSplitter {
- public:
-  VertexSplitter(const HexMesh& mesh, const std::vector<std::uint8_t>& in, const std::vector<std::array<Index, 6>>& nb,
-                 const std::vector<InterfaceQuad>& iq, const Incidence& hex_inc, const Incidence& iq_inc,
-                 const PillowOptions& opt)
-      : m_(mesh), in_(in), nb_(nb), iq_(iq), hex_inc_(hex_inc), iq_inc_(iq_inc), opt_(opt) {}
-
-  void split(Index v, std::vector<Copy>& copies) {
-    std::vector<Index> hexes;
-    for (Index k = hex_inc_.offsets[v]; k < hex_inc_.offsets[v + 1]; ++k)
-      if (in_[hex_inc_.ids[k]]) hexes.push_back(hex_inc_.ids[k]);
-    auto local = [&](Index h) { return static_cast<Index>(std::find(hexes.begin(), hexes.end(), h) - hexes.begin()); };
-    // Fans: shrink-set hexes around v connected through shrink-set/shrink-set quads containing v.
-    detail::UnionFind fans(hexes.size());
-    for (Index h : hexes)
-      for (int f = 0; f < 6; ++f) {
-        const Index n = nb_[h][f];
-        if (n >= 0 && in_[n] && face_has(h, f, v)) fans.unite(local(h), local(n));
-      }
-    std::vector<Index> roots;
-    for (Index i = 0; i < static_cast<Index>(hexes.size()); ++i)
-      if (fans.find(i) == i) roots.push_back(i);
-    for (Index root : roots) {
-      Copy c{v, Vec3::Zero(), 1.0, {}};
-      for (Index i = 0; i < static_cast<Index>(hexes.size()); ++i)
-        if (fans.find(i) == root) c.hexes.push_back(hexes[i]);
-      std::vector<Index> fan;  // interface quads of this fan at v
-      for (Index k = iq_inc_.offsets[v]; k < iq_inc_.offsets[v + 1]; ++k)
-        if (std::find(c.hexes.begin(), c.hexes.end(), iq_[iq_inc_.ids[k]].shrink_hex) != c.hexes.end())
-          fan.push_back(iq_inc_.ids[k]);
-      if (fan.empty()) continue;  // this fan is not separated from anything at v: it keeps v
-      require_one_piece(v, fan);
-      c.displacement = displacement(v, c.hexes, fan);
-      copies.push_back(std::move(c));
-    }
-  }
-
- private:
-  bool face_has(Index h, int f, Index v) const {
-    for (int c : kHexFaces[f])
-      if (m_.hexes[h][c] == v) return true;
-    return false;
-  }
-
-  /// The two neighbours of v along the quad's edges.
-  static std::array<Index, 2> edge_ends(const Quad& q, Index v) {
-    const int i = static_cast<int>(std::find(q.begin(), q.end(), v) - q.begin());
-    return {q[(i + 1) % 4], q[(i + 3) % 4]};
-  }
-
-  /// A fan whose interface quads fall apart at v touches two separate outside regions there.
-  void require_one_piece(Index v, const std::vector<Index>& fan) const {
-    detail::UnionFind pieces(fan.size());
-    for (std::size_t a = 0; a < fan.size(); ++a)
-      for (std::size_t b = a + 1; b < fan.size(); ++b) {
-        const auto ea = edge_ends(iq_[fan[a]].v, v), eb = edge_ends(iq_[fan[b]].v, v);
-        for (Index x : ea)
-          if (x == eb[0] || x == eb[1]) pieces.unite(static_cast<Index>(a), static_cast<Index>(b));
-      }
-    for (std::size_t a = 1; a < fan.size(); ++a)
-      if (pieces.find(static_cast<Index>(a)) != pieces.find(0))
-        throw Error(fmt::format(
-            "pillow: the shrink set is pinched on the outside at vertex {}: its hexes there touch two separate "
-            "regions outside the set, and one copy of the vertex cannot move away from both; add hex {} to the "
-            "shrink set or remove the hexes around it",
-            v, first_outside_hex(v)));
-  }
-
-  Index first_outside_hex(Index v) const {
-    for (Index k = hex_inc_.offsets[v]; k < hex_inc_.offsets[v + 1]; ++k)
-      if (!in_[hex_inc_.ids[k]]) return hex_inc_.ids[k];
-    return -1;
-  }
-
-  Vec3 displacement(Index v, const std::vector<Index>& fan_hexes, const std::vector<Index>& fan) const {
-    Vec3 normal = Vec3::Zero();  // into the shrink set
-    double length = 0;
-    int edges = 0;
-    for (Index q : fan) {
-      normal -= area_vector(m_, iq_[q].v);
-      for (Index w : edge_ends(iq_[q].v, v)) {
-        length += (m_.points[w] - m_.points[v]).norm();
-        ++edges;
-      }
-    }
-    if (!(normal.norm() > 0)) return Vec3::Zero();  // no direction: the check in pillow() reports it
-    normal = visible_direction(v, fan, normal.normalized());
-    // Lengthen at convex corners so that the layer is `offset` thick normal to every quad.
-    double min_cos = 1;
-    for (Index q : fan) {
-      const Vec3 a = -area_vector(m_, iq_[q].v);
-      if (a.norm() > 0) min_cos = std::min(min_cos, normal.dot(a.normalized()));
-    }
-    Vec3 d = normal * (opt_.offset * length / edges / std::max(min_cos, 0.5));
-    // Where the fan still has boundary quads at v, the interface ends on the boundary: the
-    // copy stays in the boundary's tangent plane so the sheet ends there too.
-    Vec3 boundary_normal = Vec3::Zero();
-    if (!opt_.include_boundary)
-      for (Index h : fan_hexes)
-        for (int f = 0; f < 6; ++f)
-          if (nb_[h][f] < 0 && face_has(h, f, v)) {
-            const auto& fc = kHexFaces[f];
-            boundary_normal += area_vector(m_, {m_.hexes[h][fc[0]], m_.hexes[h][fc[1]], m_.hexes[h][fc[2]],
-                                                m_.hexes[h][fc[3]]});
-          }
-    if (boundary_normal.norm() > 0) {
-      const Vec3 b = boundary_normal.normalized();
-      d -= d.dot(b) * b;
-    }
-    return d;
-  }
-
-  /// As a copy's displacement shrinks to zero, a new hex stays positive only if the
-  /// displacement points to the shrink side of each fan quad's corner at v. On a curved or
-  /// folded interface the mean normal may not, so tilt it toward the worst corner normal
-  /// until every corner sees it (or keep the best found: the halving loop then reports it).
-  Vec3 visible_direction(Index v, const std::vector<Index>& fan, Vec3 d) const {
-    std::vector<Vec3> corner_normals;
-    for (Index q : fan) {
-      const auto [next, prev] = edge_ends(iq_[q].v, v);
-      const Vec3 n = (m_.points[prev] - m_.points[v]).cross(m_.points[next] - m_.points[v]);  // into the shrink set
-      if (n.norm() > 0) corner_normals.push_back(n.normalized());
-    }
-    auto worst = [&](const Vec3& x, Vec3& n) {
-      double lo = 2;
-      for (const Vec3& c : corner_normals)
-        if (x.dot(c) < lo) lo = x.dot(c), n = c;
-      return lo;
-    };
-    constexpr double kEnough = 0.2;  // cos of 78°: comfortably positive corners
-    Vec3 n = d, best = d;
-    double best_lo = worst(d, n);
-    // Subgradient ascent on min_i d·n_i with a decreasing step (a tiny LP; exactness is not
-    // needed, only a direction with a positive margin where one exists).
-    for (int it = 0; it < 400 && best_lo < kEnough; ++it) {
-      d = (d + 0.2 / (1 + it / 20.0) * n).normalized();
-      const double lo = worst(d, n);
-      if (lo > best_lo) best_lo = lo, best = d;
-    }
-    if (!(best_lo > 0))
-      throw Error(fmt::format(
-          "pillow: the shrink set is pinched or folded at vertex {}: no direction from it into the shrink set "
-          "sees all {} of its interface quads there, so no copy of it can be placed without inverting a new hex; "
-          "add hex {} to the shrink set or remove the hexes around it",
-          v, corner_normals.size(), first_outside_hex(v)));
-    return best;
-  }
-
-  const HexMesh& m_;
-  const std::vector<std::uint8_t>& in_;
-  const std::vector<std::array<Index, 6>>& nb_;
-  const std::vector<InterfaceQuad>& iq_;
-  const Incidence& hex_inc_;
-  const Incidence& iq_inc_;
-  const PillowOptions& opt_;
-};
+/// Rounds of hex flips tried at pinches with no placement (each round flips one hex at every
+/// such vertex; a few rounds settle every case seen in the property tests).
+constexpr int kMaxFlipRounds = 64;
 
 bool positive(double sj) { return sj > 0 && !is_degenerate(sj); }
 
@@ -244,95 +73,131 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
     nb[q.hex[0]][q.local[0]] = q.hex[1];
     if (!q.is_boundary()) nb[q.hex[1]][q.local[1]] = q.hex[0];
   }
-  const std::vector<InterfaceQuad> iq = find_interface(quads, shrink_set, options.include_boundary);
-  if (iq.empty())
-    throw Error(options.include_boundary
-                    ? "pillow: the shrink set has no interface (no quad between it and the rest of the mesh, and "
-                      "no boundary quad)"
-                    : "pillow: the shrink set has no interface: it contains every hex of its part of the mesh "
-                      "(pillow the boundary instead)");
-  std::vector<Quad> iq_quads;
-  iq_quads.reserve(iq.size());
-  for (const auto& q : iq) iq_quads.push_back(q.v);
-  const Incidence iq_inc = vertex_cells(iq_quads, mesh.num_vertices());
+  // A pinch that no choice of merge sides can place (e.g. two outside hexes meeting along an
+  // edge inside the shrink set where the edge's other end needs the opposite choice) is undone
+  // by flipping one hex there, and the split redone; the flips are reported.
+  std::vector<std::uint8_t> in(shrink_set.size());
+  for (std::size_t h = 0; h < in.size(); ++h) in[h] = shrink_set[h] != 0;
+  std::size_t members = static_cast<std::size_t>(std::count(in.begin(), in.end(), 1));
+  std::vector<InterfaceQuad> iq;
+  detail::InterfaceSplit split;
   const Incidence hex_inc = vertex_hexes(mesh);
+  for (int round = 0;; ++round) {
+    iq = find_interface(quads, in, options.include_boundary);
+    if (iq.empty())
+      throw Error(options.include_boundary
+                      ? "pillow: the shrink set has no interface (no quad between it and the rest of the mesh, and "
+                        "no boundary quad)"
+                      : "pillow: the shrink set has no interface: it contains every hex of its part of the mesh "
+                        "(pillow the boundary instead)");
+    split = detail::split_interface(mesh, in, nb, iq, options);
+    if (split.flip_candidates.empty() || round == kMaxFlipRounds) break;
+    // One flip per neighbourhood per round: a flip changes the interface around all of its
+    // hex's vertices, which often settles the neighbouring stuck vertices too.
+    bool flipped = false;
+    std::vector<Index> touched;  // hexes flipped this round
+    for (const auto& [v, h] : split.flip_candidates) {
+      bool near = false;
+      for (Index k = hex_inc.offsets[v]; k < hex_inc.offsets[v + 1] && !near; ++k)
+        near = std::find(touched.begin(), touched.end(), hex_inc.ids[k]) != touched.end();
+      if (near) continue;
+      const bool leaving = in[h] != 0;
+      if (leaving ? members == 1 : members + 1 == in.size()) continue;  // keep an interface
+      in[h] = !leaving;
+      touched.push_back(h);
+      members += leaving ? -1 : 1;
+      flipped = true;
+    }
+    if (!flipped) break;
+  }
+
+  if (!split.unpaired_edges.empty())
+    throw Error(fmt::format("pillow: cannot pair the new hexes along the pinched edge {}-{} even after flipping "
+                            "hexes of the shrink set around it; change the shrink set there",
+                            split.unpaired_edges[0][0], split.unpaired_edges[0][1]));
 
   PillowResult r;
-  std::vector<Copy> copies;
-  VertexSplitter splitter(mesh, shrink_set, nb, iq, hex_inc, iq_inc, options);
-  for (Index v = 0; v < mesh.num_vertices(); ++v)
-    if (iq_inc.count(v) > 0) {
-      ++r.interface_vertices;
-      splitter.split(v, copies);
-    }
+  for (Index h = 0; h < mesh.num_hexes(); ++h)
+    if (in[h] != (shrink_set[h] != 0)) (in[h] ? r.added : r.removed).push_back(h);
   r.interface_quads = iq.size();
-  r.pinch_copies = copies.size() - r.interface_vertices;
+  r.interface_vertices = split.interface_vertices;
+  r.pinched_edges = split.pinched_edges;
+  r.flipped_edges = split.flipped_edges;
+  r.folded_vertices = static_cast<std::size_t>(std::count(split.folded.begin(), split.folded.end(), 1));
 
-  // Shrink: the fans' hexes take the copies.
+  // Split: each non-keeper group's hexes take its new vertex.
   HexMesh& out = r.mesh;
   out = mesh;
   const Index nv0 = mesh.num_vertices(), nh0 = mesh.num_hexes();
+  std::vector<const detail::SplitVertex*> copies;  // by new id - nv0
   std::vector<Index> changed;
-  for (std::size_t c = 0; c < copies.size(); ++c) {
-    const Index id = nv0 + static_cast<Index>(c);
-    out.points.push_back(mesh.points[copies[c].original] + copies[c].displacement);
-    r.copy_of.push_back(copies[c].original);
-    for (Index h : copies[c].hexes) {
+  for (const detail::SplitVertex& sv : split.vertices) {
+    if (sv.id == sv.original) continue;
+    copies.push_back(&sv);
+    out.points.push_back(mesh.points[sv.original] + sv.displacement);
+    r.copy_of.push_back(sv.original);
+    r.outside_copies += !sv.shrink_side;
+    for (Index h : sv.hexes) {
       for (Index& x : out.hexes[h])
-        if (x == copies[c].original) x = id;
+        if (x == sv.original) x = sv.id;
       changed.push_back(h);
     }
   }
+  r.pinch_copies = copies.size() - r.interface_vertices;
   std::sort(changed.begin(), changed.end());
   changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
   if (out.has_fixed()) out.fixed.resize(out.points.size(), 0);
 
   // Connect: one hex per interface quad. The quad faces away from the shrink set, so its
-  // reverse is the bottom (0-1-2-3, facing into the new hex) and the copies are the top.
-  out.hexes.reserve(mesh.hexes.size() + iq.size());  // keeps `after` below valid
-  for (const InterfaceQuad& q : iq) {
-    const Hex& before = mesh.hexes[q.shrink_hex];
-    const Hex& after = out.hexes[q.shrink_hex];
-    auto copy = [&](Index v) { return after[std::find(before.begin(), before.end(), v) - before.begin()]; };
-    out.hexes.push_back({q.v[0], q.v[3], q.v[2], q.v[1], copy(q.v[0]), copy(q.v[3]), copy(q.v[2]), copy(q.v[1])});
-    if (out.has_blocks()) out.blocks.push_back(mesh.blocks[q.shrink_hex]);
+  // reverse (outside-side vertices) is the bottom, facing into the new hex, and the
+  // shrink-side vertices are the top.
+  out.hexes.reserve(mesh.hexes.size() + iq.size());
+  for (std::size_t q = 0; q < iq.size(); ++q) {
+    const Quad& o = split.outside_ids[q];
+    const Quad& s = split.shrink_ids[q];
+    out.hexes.push_back({o[0], o[3], o[2], o[1], s[0], s[3], s[2], s[1]});
+    if (out.has_blocks()) out.blocks.push_back(mesh.blocks[iq[q].shrink_hex]);
   }
 
-  // Halve the displacements of copies used by inverted new or changed hexes until none is.
+  // Halve the displacements of vertices used by inverted new or changed hexes until none
+  // is. New hexes at a folded vertex (where no placement can make them positive) are left to
+  // an untangler rather than collapsing their neighbours' layer.
   std::vector<Index> checked = changed;
-  for (Index h = nh0; h < out.num_hexes(); ++h) checked.push_back(h);
-  std::vector<char> was_positive(checked.size(), 1);
-  for (std::size_t i = 0; i < changed.size(); ++i) was_positive[i] = positive(scaled_jacobian(mesh.corners(changed[i])));
-  std::vector<char> reduced(copies.size(), 0);
-  for (int round = 0;; ++round) {
+  std::vector<char> was_positive(changed.size(), 1);
+  for (std::size_t i = 0; i < changed.size(); ++i)
+    was_positive[i] = positive(scaled_jacobian(mesh.corners(changed[i])));
+  for (std::size_t q = 0; q < iq.size(); ++q)
+    if (std::none_of(iq[q].v.begin(), iq[q].v.end(), [&](Index v) { return split.folded[v] != 0; })) {
+      checked.push_back(nh0 + static_cast<Index>(q));
+      was_positive.push_back(1);
+    }
+  std::vector<double> scale(copies.size(), 1.0);
+  for (int round = 0; round < options.max_halvings; ++round) {
     std::vector<char> halve(copies.size(), 0);
-    Index bad_hex = -1;
+    bool any = false;
     for (std::size_t i = 0; i < checked.size(); ++i) {
       if (!was_positive[i] || positive(scaled_jacobian(out.corners(checked[i])))) continue;
-      bad_hex = checked[i];
+      any = true;
       for (Index x : out.hexes[checked[i]])
         if (x >= nv0) halve[x - nv0] = 1;
     }
-    if (bad_hex < 0) break;
-    if (round == options.max_halvings) {
-      Index v = -1;
-      for (Index x : out.hexes[bad_hex])
-        if (x >= nv0) v = copies[x - nv0].original;
-      throw Error(fmt::format("pillow: cannot place the copy of vertex {} without inverting {} hex {} (its "
-                              "displacement was halved {} times); the shrink set is too thin or folded there",
-                              v, bad_hex < nh0 ? "shrink-set" : "new", bad_hex, options.max_halvings));
-    }
+    if (!any) break;
     for (std::size_t c = 0; c < copies.size(); ++c)
       if (halve[c]) {
-        copies[c].scale *= 0.5;
-        reduced[c] = 1;
-        out.points[nv0 + c] = mesh.points[copies[c].original] + copies[c].scale * copies[c].displacement;
+        scale[c] *= 0.5;
+        out.points[nv0 + c] = mesh.points[copies[c]->original] + scale[c] * copies[c]->displacement;
       }
   }
-  r.reduced_vertices = static_cast<std::size_t>(std::count(reduced.begin(), reduced.end(), 1));
+  r.reduced_vertices =
+      static_cast<std::size_t>(std::count_if(scale.begin(), scale.end(), [](double x) { return x < 1; }));
   r.min_new_scaled_jacobian = 1.0;
-  for (Index h = nh0; h < out.num_hexes(); ++h)
-    r.min_new_scaled_jacobian = std::min(r.min_new_scaled_jacobian, scaled_jacobian(out.corners(h)));
+  for (Index h = nh0; h < out.num_hexes(); ++h) {
+    const double sj = scaled_jacobian(out.corners(h));
+    r.min_new_scaled_jacobian = std::min(r.min_new_scaled_jacobian, sj);
+    r.inverted_new_hexes += !positive(sj);
+  }
+  for (std::size_t i = 0; i < changed.size(); ++i)
+    r.inverted_changed_hexes += was_positive[i] && !positive(scaled_jacobian(out.corners(changed[i])));
   return r;
 }
 
