@@ -1,5 +1,6 @@
 // Worst-element pass: local max–min moves on Verdict's scaled Jacobian itself.
 #include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/feasibility.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
@@ -34,25 +35,12 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
   return lo;
 }
 
-double mean_edge(const HexMesh& mesh, const Incidence& inc, Index v) {
-  double sum = 0;
-  int n = 0;
-  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
-    for (const auto& e : kHexEdges) {
-      const Hex& hx = mesh.hexes[inc.ids[i]];
-      if (hx[e[0]] != v && hx[e[1]] != v) continue;
-      sum += (mesh.points[hx[e[0]]] - mesh.points[hx[e[1]]]).norm();
-      ++n;
-    }
-  return n ? sum / n : 0.0;
-}
-
 // One max–min move of v: a finite-difference ascent direction of the local minimum, then
 // shrinking steps; the first that raises the local minimum (inverting nothing) is taken.
 bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySurface* surface) {
   const Vec3 x0 = mesh.points[v];
   const double m0 = local_min(mesh, inc, v, x0);
-  const double len = mean_edge(mesh, inc, v);
+  const double len = opt::mean_edge_at(mesh, inc, v);
   if (!(len > 0)) return false;
   const double h = 1e-5 * len;
   Vec3 g;

@@ -1,5 +1,6 @@
 // The quality-distribution figure as a raster image: the chart of histogram_svg.cpp drawn
 // with RgbImage, for viewers and documents that take PNG but not SVG.
+#include "isohex/quality/plot_detail.hpp"
 #include "isohex/quality/report.hpp"
 
 #include <fmt/format.h>
@@ -19,19 +20,6 @@ Rgb bar_colour(const MetricSummary& s, double lo) {
   return rgb_from_hex("#228833");
 }
 
-// About 5 ticks at 1, 2 or 5 times a power of ten, up to the first at or above `top`.
-std::vector<double> count_ticks(double top) {
-  const double raw = top / 5;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  const double step = raw <= p ? p : raw <= 2 * p ? 2 * p : raw <= 5 * p ? 5 * p : 10 * p;
-  std::vector<double> t;
-  for (double v = 0;; v += step) {
-    t.push_back(v);
-    if (v >= top) break;
-  }
-  return t;
-}
-
 void centred_text(RgbImage& img, int cx, int y, const std::string& s, Rgb c, int scale) {
   img.text(cx - RgbImage::text_width(s, scale) / 2, y, s, c, scale);
 }
@@ -49,7 +37,7 @@ RgbImage histogram_image(const MetricSummary& s, const HistogramPlotOptions& opt
   const std::size_t n = h.counts.size();
   const std::size_t peak = n ? *std::max_element(h.counts.begin(), h.counts.end()) : 0;
   const double decades = peak > 0 ? std::ceil(std::log10(static_cast<double>(peak))) : 0;
-  const std::vector<double> ticks = count_ticks(std::max<double>(static_cast<double>(peak), 1.0));
+  const std::vector<double> ticks = detail::linear_ticks(std::max<double>(static_cast<double>(peak), 1.0));
   const double lin_top = std::max(ticks.back(), 1.0);
   auto yfrac = [&](double count) {
     if (options.log_scale) return count > 0 ? (1 + std::log10(count)) / (1 + decades) : 0.0;

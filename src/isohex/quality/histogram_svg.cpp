@@ -1,5 +1,6 @@
 // The quality-distribution figure: a bar chart like the paper's Figures 9, 11, 13 and 15.
 #include "isohex/io/atomic_file.hpp"
+#include "isohex/quality/plot_detail.hpp"
 #include "isohex/quality/summary.hpp"
 
 #include <fmt/format.h>
@@ -12,39 +13,11 @@ namespace isohex {
 
 namespace {
 
-std::string escape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 const char* bar_colour(const MetricSummary& s, double lo) {
   if (s.metric != HexMetric::scaled_jacobian) return "#4477aa";
   if (lo < 0) return "#cc3311";
   if (lo < kQuestionableSJ) return "#ee7733";
   return "#228833";
-}
-
-// Tick values for a linear count axis: 1, 2 or 5 times a power of ten, about 5 ticks.
-std::vector<double> linear_ticks(double top) {
-  const double raw = top / 5;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  const double step = raw <= p ? p : raw <= 2 * p ? 2 * p : raw <= 5 * p ? 5 * p : 10 * p;
-  std::vector<double> t;
-  // Up to the first tick at or above `top`, so that the tallest bar stays inside the plot.
-  for (double v = 0;; v += step) {
-    t.push_back(v);
-    if (v >= top) break;
-  }
-  return t;
 }
 
 }  // namespace
@@ -59,7 +32,7 @@ std::string histogram_svg(const MetricSummary& s, const HistogramPlotOptions& op
   // Count → height in [0, 1] of the plot.
   // Log axis: a count c > 0 sits at (1 + log10 c) / (1 + decades), so one element is visible.
   const double decades = peak > 0 ? std::ceil(std::log10(static_cast<double>(peak))) : 0;
-  const std::vector<double> ticks = linear_ticks(std::max<double>(static_cast<double>(peak), 1.0));
+  const std::vector<double> ticks = detail::linear_ticks(std::max<double>(static_cast<double>(peak), 1.0));
   const double lin_top = std::max(ticks.back(), 1.0);
   auto yfrac = [&](double count) {
     if (options.log_scale) return count > 0 ? (1 + std::log10(count)) / (1 + decades) : 0.0;
@@ -75,12 +48,12 @@ std::string histogram_svg(const MetricSummary& s, const HistogramPlotOptions& op
   const std::string title = options.title.empty() ? std::string(metric_name(s.metric)) + " distribution"
                                                   : options.title;
   fmt::format_to(out, "<text x=\"{}\" y=\"22\" font-size=\"16\" text-anchor=\"middle\">{}</text>\n", W / 2,
-                 escape(title));
+                 detail::escape_markup(title));
   std::string line = fmt::format("{} elements, min {:.4g}, mean {:.4g}, max {:.4g}", s.count, s.min, s.mean, s.max);
   if (s.metric == HexMetric::scaled_jacobian)
     line += fmt::format(", inverted {}, < {} {}", s.inverted, kQuestionableSJ, s.inverted + s.questionable);
   if (s.degenerate) line += fmt::format(", degenerate {}", s.degenerate);
-  fmt::format_to(out, "<text x=\"{}\" y=\"42\" text-anchor=\"middle\" fill=\"#444\">{}</text>\n", W / 2, escape(line));
+  fmt::format_to(out, "<text x=\"{}\" y=\"42\" text-anchor=\"middle\" fill=\"#444\">{}</text>\n", W / 2, detail::escape_markup(line));
 
   // Axes and grid.
   if (options.log_scale) {
@@ -121,7 +94,7 @@ std::string histogram_svg(const MetricSummary& s, const HistogramPlotOptions& op
                    h.edges[i]);
   }
   fmt::format_to(out, "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n", left + pw / 2, H - 22,
-                 escape(metric_name(s.metric)));
+                 detail::escape_markup(metric_name(s.metric)));
   fmt::format_to(out,
                  "<text x=\"18\" y=\"{}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {})\">elements{}</text>\n",
                  top + ph / 2, top + ph / 2, options.log_scale ? " (log scale)" : "");
@@ -136,3 +109,34 @@ void write_histogram_svg(const std::filesystem::path& file, const MetricSummary&
 }
 
 }  // namespace isohex
+
+namespace isohex::detail {
+
+std::vector<double> linear_ticks(double top) {
+  const double raw = top / 5;
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  const double step = raw <= p ? p : raw <= 2 * p ? 2 * p : raw <= 5 * p ? 5 * p : 10 * p;
+  std::vector<double> t;
+  // Up to the first tick at or above `top`, so that the tallest bar stays inside the plot.
+  for (double v = 0;; v += step) {
+    t.push_back(v);
+    if (v >= top) break;
+  }
+  return t;
+}
+
+std::string escape_markup(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace isohex::detail

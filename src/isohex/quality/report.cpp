@@ -1,5 +1,6 @@
 // write_report(): report.json, the per-stage histogram figures and the self-contained
 // report.html (tables, inline SVG figures, the embedded WebGL viewer).
+#include "isohex/quality/plot_detail.hpp"
 #include "isohex/quality/report.hpp"
 
 #include "isohex/error.hpp"
@@ -19,20 +20,6 @@ using nlohmann::json;
 
 namespace {
 
-std::string escape_html(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 // JSON for a <script> element: '<' escaped, so that no string can close the element.
 std::string script_json(const json& j) {
@@ -126,11 +113,11 @@ std::string stage_table_html(const std::vector<StageResult>& r) {
     std::vector<std::pair<std::string, std::string>> notes;
     flatten(s.stage->extra, "", notes);
     std::string n;
-    for (const auto& [k, v] : notes) n += (n.empty() ? "" : "; ") + escape_html(k) + ": " + escape_html(v);
+    for (const auto& [k, v] : notes) n += (n.empty() ? "" : "; ") + detail::escape_markup(k) + ": " + detail::escape_markup(v);
     h += fmt::format(
         "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td{}>{}</td><td>{}</td><td{}>{}</td><td>{}</td><td>{}</td>"
         "<td>{}</td><td class=\"l\">{}</td></tr>\n",
-        escape_html(s.stage->name), m.count, s.stage->vertices ? fmt::format("{}", s.stage->vertices) : "–",
+        detail::escape_markup(s.stage->name), m.count, s.stage->vertices ? fmt::format("{}", s.stage->vertices) : "–",
         m.min < 0 ? " class=\"bad\"" : "", sj_text(m.min), sj_text(m.mean), m.inverted ? " class=\"bad\"" : "",
         m.inverted, m.inverted + m.questionable, m.degenerate,
         s.stage->seconds >= 0 ? fmt::format("{:.3f}", s.stage->seconds) : "–", n);
@@ -144,7 +131,7 @@ std::string facts_table_html(const json& summary) {
   if (rows.empty()) return "<p class=\"note\">No run facts were given.</p>\n";
   std::string h = "<table>\n";
   for (const auto& [k, v] : rows)
-    h += fmt::format("<tr><th class=\"l\">{}</th><td class=\"l\">{}</td></tr>\n", escape_html(k), escape_html(v));
+    h += fmt::format("<tr><th class=\"l\">{}</th><td class=\"l\">{}</td></tr>\n", detail::escape_markup(k), detail::escape_markup(v));
   return h + "</table>\n";
 }
 
@@ -208,9 +195,9 @@ ReportFiles write_report(const fs::path& dir, const ReportInput& in) {
   std::string h;
   h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
        "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
-  h += fmt::format("<title>{}</title>\n<style>{}</style>\n</head>\n<body>\n", escape_html(in.title),
+  h += fmt::format("<title>{}</title>\n<style>{}</style>\n</head>\n<body>\n", detail::escape_markup(in.title),
                    report_detail::kReportCss);
-  h += fmt::format("<h1>{}</h1>\n", escape_html(in.title));
+  h += fmt::format("<h1>{}</h1>\n", detail::escape_markup(in.title));
   h += cards_html(results);
   if (view) {
     h += report_detail::kViewerHtml;
@@ -221,7 +208,7 @@ ReportFiles write_report(const fs::path& dir, const ReportInput& in) {
   h += "<h2>Quality distribution</h2>\n<div class=\"figures\">\n";
   for (const auto& r : results)
     h += fmt::format("<figure>\n{}<figcaption>{} (<a href=\"{}\">SVG</a>, <a href=\"{}\">PNG</a>)</figcaption>\n</figure>\n",
-                     r.svg, escape_html(r.stage->name), r.svg_file, r.png_file);
+                     r.svg, detail::escape_markup(r.stage->name), r.svg_file, r.png_file);
   h += "</div>\n<h2>Run</h2>\n" + facts_table_html(in.summary);
   h += "<p class=\"note\">Written by isohex. The numbers are also in report.json; scaled Jacobians follow Verdict "
        "(1 for a cube, below 0 for an inverted hex).</p>\n";
