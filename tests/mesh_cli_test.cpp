@@ -108,3 +108,24 @@ TEST(MeshCli, PipelineRunsEveryStageAndKeepsTheBoundary) {
   };
   EXPECT_EQ(surface(a), surface(b));
 }
+
+// A head in a sphere that reaches past the scan (the paper's figure 12 setting): cells whose
+// samples the repair flipped take the nearest surface relative to its scale (a sphere's level
+// is a length, the isosurface's a value) and every surface vertex lies on its surface.
+TEST(MeshCli, HeadInASphereKeepsEverySurfaceVertexOnItsSurface) {
+  ISOHEX_REQUIRE_SHARED_DATA();
+  const auto dir = scratch_dir();
+  std::string out;
+  const std::string ct = q(isohex::test::shared_data("volumes/cthead_256x256x113_int16be.raw"));
+  ASSERT_EQ(run_cli("mesh " + ct + " --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 "
+                        "--cell-size 8 --region outside --outer sphere:127.5,127.5,112,160 --no-surface-smoothing "
+                        "--no-pillow --no-smooth -o " + q(dir / "s.vtu") + " --json " + q(dir / "s.json"),
+                    &out),
+            0)
+      << out;
+  const auto j = nlohmann::json::parse(io::read_file(dir / "s.json"));
+  EXPECT_TRUE(j["valid"].get<bool>());
+  EXPECT_EQ(j["off_surface_vertices"], 0);
+  EXPECT_LE(j["max_relative_distance"].get<double>(), 1e-6);
+  EXPECT_GT(j["simple_points"].get<int>(), 0);  // the case does go through the flipped-cell path
+}

@@ -173,20 +173,26 @@ Placement place_vertex(const Region& region, const SampledGrid& g, std::size_t i
     return {x, kBoxVertex, false};
   }
   if (surface < 0) {
-    // Only filled points here: project onto the nearest surface, if any is within reach.
-    double best = std::numeric_limits<double>::infinity();
-    for (int s = 0; s < num_surfaces; ++s) {
-      const double l = std::abs(region.surfaces[static_cast<std::size_t>(s)].level(x));
-      if (l < best) {
-        best = l;
-        surface = s;
-      }
+    // Only flipped points here: project onto the nearest surface within reach. Levels of
+    // different surfaces are in different units (values, lengths), so they are compared
+    // relative to each surface's scale, and each surface is tried in that order. A flipped
+    // point is next to the surface it was flipped across, so allow a longer reach than usual.
+    int order[kMaxSurfaces];
+    double rel[kMaxSurfaces];
+    const int n = std::min(num_surfaces, kMaxSurfaces);
+    for (int s = 0; s < n; ++s) {
+      const LevelSet& ls = region.surfaces[static_cast<std::size_t>(s)];
+      rel[s] = std::abs(ls.level(x)) / ls.scale();
+      order[s] = s;
     }
-    // A filled point is within a cell diagonal of a truly inside one, so the surface is
-    // near; allow a longer reach than usual.
+    std::stable_sort(order, order + n, [&](int a, int b) { return rel[a] < rel[b]; });
+    for (int k = 0; k < n; ++k) {
+      Vec3 y = x;
+      if (region.surfaces[static_cast<std::size_t>(order[k])].project(y, 3 * h))
+        return {y, static_cast<std::int8_t>(order[k]), false};
+    }
+    surface = order[0];
     const LevelSet& ls = region.surfaces[static_cast<std::size_t>(surface)];
-    Vec3 y = x;
-    if (ls.project(y, 3 * h)) return {y, static_cast<std::int8_t>(surface), false};
     // Last resort: the zero between x and the nearest grid point on the other side of the
     // surface within the 4x4x4 points around the cell (one exists: the filled points border
     // truly inside ones).
