@@ -14,9 +14,9 @@
 
 namespace isohex::contour {
 
-std::uint8_t SampledGrid::cell_mask(std::size_t i, std::size_t j, std::size_t k) const {
-  const std::size_t base = index(i, j, k), dy = padded[0], dz = padded[0] * padded[1];
-  const std::uint8_t* p = inside.data() + base;
+std::uint8_t SampledGrid::cell_mask_at(std::size_t cell) const {
+  const std::size_t dy = padded[0], dz = padded[0] * padded[1];
+  const std::uint8_t* p = inside.data() + cell;
   return static_cast<std::uint8_t>(p[0] | p[1] << 1 | p[dy] << 2 | p[dy + 1] << 3 | p[dz] << 4 | p[dz + 1] << 5 |
                                    p[dz + dy] << 6 | p[dz + dy + 1] << 7);
 }
@@ -155,16 +155,9 @@ std::array<std::size_t, 8> cells_around(const SampledGrid& g, std::size_t p) {
   return cells;
 }
 
-std::uint8_t mask_at(const SampledGrid& g, std::size_t cell) {
-  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
-  const std::uint8_t* p = g.inside.data() + cell;
-  return static_cast<std::uint8_t>(p[0] | p[1] << 1 | p[dy] << 2 | p[dy + 1] << 3 | p[dz] << 4 | p[dz + 1] << 5 |
-                                   p[dz + dy] << 6 | p[dz + dy + 1] << 7);
-}
-
 int non_manifold_around(const SampledGrid& g, std::size_t p) {
   int n = 0;
-  for (std::size_t cell : cells_around(g, p)) n += !cell_case(mask_at(g, cell)).manifold;
+  for (std::size_t cell : cells_around(g, p)) n += !cell_case(g.cell_mask_at(cell)).manifold;
   return n;
 }
 
@@ -236,7 +229,7 @@ class FlipSearch {
         } else if (len + 1 < max_depth_) {
           std::vector<std::size_t> next;
           for (std::size_t q : cells_around(g_, p))
-            if (!cell_case(mask_at(g_, q)).manifold) next.push_back(q);
+            if (!cell_case(g_.cell_mask_at(q)).manifold) next.push_back(q);
           if (!next.empty()) search(next, len + 1, d, sc);
         }
         g_.inside[p] ^= 1;
@@ -269,7 +262,7 @@ void simple_phase(SampledGrid& g, RepairCounts& counts) {
     std::size_t flips = 0;
     for (const auto& slab : found)
       for (std::size_t cell : slab) {
-        if (cell_case(mask_at(g, cell)).manifold) continue;  // an earlier flip fixed it
+        if (cell_case(g.cell_mask_at(cell)).manifold) continue;  // an earlier flip fixed it
         const int n = search.repair(cell);
         for (int s = 0; s < n; ++s) {
           ++(g.inside[search.flips()[s]] ? counts.filled : counts.carved);

@@ -37,7 +37,9 @@ struct SampledGrid {
     return i == 0 || j == 0 || k == 0 || i + 1 == padded[0] || j + 1 == padded[1] || k + 1 == padded[2];
   }
   /// Bit c set when corner c (offset (c&1, c>>1&1, c>>2&1)) of cell (i, j, k) is inside.
-  [[nodiscard]] std::uint8_t cell_mask(std::size_t i, std::size_t j, std::size_t k) const;
+  [[nodiscard]] std::uint8_t cell_mask(std::size_t i, std::size_t j, std::size_t k) const { return cell_mask_at(index(i, j, k)); }
+  /// The same for the cell whose lowest corner has padded index `cell`.
+  [[nodiscard]] std::uint8_t cell_mask_at(std::size_t cell) const;
   /// Bit c set when corner c of cell (i, j, k) is padding.
   [[nodiscard]] std::uint8_t padding_mask(std::size_t i, std::size_t j, std::size_t k) const;
 };

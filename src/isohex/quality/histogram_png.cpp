@@ -12,14 +12,6 @@ namespace isohex {
 
 namespace {
 
-// The SVG figure's colours, so that both figures read the same.
-Rgb bar_colour(const MetricSummary& s, double lo) {
-  if (s.metric != HexMetric::scaled_jacobian) return rgb_from_hex("#4477aa");
-  if (lo < 0) return rgb_from_hex("#cc3311");
-  if (lo < kQuestionableSJ) return rgb_from_hex("#ee7733");
-  return rgb_from_hex("#228833");
-}
-
 void centred_text(RgbImage& img, int cx, int y, const std::string& s, Rgb c, int scale) {
   img.text(cx - RgbImage::text_width(s, scale) / 2, y, s, c, scale);
 }
@@ -35,14 +27,10 @@ RgbImage histogram_image(const MetricSummary& s, const HistogramPlotOptions& opt
 
   const auto& h = s.histogram;
   const std::size_t n = h.counts.size();
-  const std::size_t peak = n ? *std::max_element(h.counts.begin(), h.counts.end()) : 0;
-  const double decades = peak > 0 ? std::ceil(std::log10(static_cast<double>(peak))) : 0;
-  const std::vector<double> ticks = detail::linear_ticks(std::max<double>(static_cast<double>(peak), 1.0));
-  const double lin_top = std::max(ticks.back(), 1.0);
-  auto yfrac = [&](double count) {
-    if (options.log_scale) return count > 0 ? (1 + std::log10(count)) / (1 + decades) : 0.0;
-    return count / lin_top;
-  };
+  const detail::CountAxis axis(s, options.log_scale);  // as in the SVG figure
+  const double decades = axis.decades;
+  const std::vector<double>& ticks = axis.ticks;
+  auto yfrac = [&](double count) { return axis.frac(count); };
   auto ypix = [&](double count) { return top + static_cast<int>(std::lround(ph * (1 - yfrac(count)))); };
 
   const std::string title = options.title.empty() ? std::string(metric_name(s.metric)) + " distribution" : options.title;
@@ -87,7 +75,7 @@ RgbImage histogram_image(const MetricSummary& s, const HistogramPlotOptions& opt
     const int x1 = left + static_cast<int>(std::lround(bw * static_cast<double>(i + 1)));
     // At least one pixel high, so that a single inverted hex is visible next to thousands.
     const int y0 = std::min(ypix(static_cast<double>(h.counts[i])), top + ph - 1);
-    img.fill_rect(x0, y0, x1, top + ph, bar_colour(s, h.edges[i]));
+    img.fill_rect(x0, y0, x1, top + ph, rgb_from_hex(detail::bar_colour(s, h.edges[i])));
     const std::string c = fmt::format("{}", h.counts[i]);
     const int scale = RgbImage::text_width(c, 2) <= x1 - x0 ? 2 : 1;
     centred_text(img, (x0 + x1) / 2, y0 - 4 - 7 * scale, c, ink, scale);

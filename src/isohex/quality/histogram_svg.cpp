@@ -11,33 +11,15 @@
 
 namespace isohex {
 
-namespace {
-
-const char* bar_colour(const MetricSummary& s, double lo) {
-  if (s.metric != HexMetric::scaled_jacobian) return "#4477aa";
-  if (lo < 0) return "#cc3311";
-  if (lo < kQuestionableSJ) return "#ee7733";
-  return "#228833";
-}
-
-}  // namespace
-
 std::string histogram_svg(const MetricSummary& s, const HistogramPlotOptions& options) {
   const double W = 760, H = 440, left = 80, right = 20, top = 60, bottom = 70;
   const double pw = W - left - right, ph = H - top - bottom;
   const auto& h = s.histogram;
   const std::size_t n = h.counts.size();
-  const std::size_t peak = n ? *std::max_element(h.counts.begin(), h.counts.end()) : 0;
-
-  // Count → height in [0, 1] of the plot.
-  // Log axis: a count c > 0 sits at (1 + log10 c) / (1 + decades), so one element is visible.
-  const double decades = peak > 0 ? std::ceil(std::log10(static_cast<double>(peak))) : 0;
-  const std::vector<double> ticks = detail::linear_ticks(std::max<double>(static_cast<double>(peak), 1.0));
-  const double lin_top = std::max(ticks.back(), 1.0);
-  auto yfrac = [&](double count) {
-    if (options.log_scale) return count > 0 ? (1 + std::log10(count)) / (1 + decades) : 0.0;
-    return count / lin_top;
-  };
+  const detail::CountAxis axis(s, options.log_scale);
+  const double decades = axis.decades;
+  const std::vector<double>& ticks = axis.ticks;
+  auto yfrac = [&](double count) { return axis.frac(count); };
 
   std::string svg;
   auto out = std::back_inserter(svg);
@@ -82,7 +64,7 @@ std::string histogram_svg(const MetricSummary& s, const HistogramPlotOptions& op
       fmt::format_to(out,
                      "<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"{}\" "
                      "stroke=\"white\"><title>[{:.3g}, {:.3g}): {}</title></rect>\n",
-                     x, top + ph - bh, bw, bh, bar_colour(s, h.edges[i]), h.edges[i], h.edges[i + 1], h.counts[i]);
+                     x, top + ph - bh, bw, bh, detail::bar_colour(s, h.edges[i]), h.edges[i], h.edges[i + 1], h.counts[i]);
       fmt::format_to(out, "<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"10\">{}</text>\n",
                      x + bw / 2, top + ph - bh - 3, h.counts[i]);
     }
@@ -111,6 +93,25 @@ void write_histogram_svg(const std::filesystem::path& file, const MetricSummary&
 }  // namespace isohex
 
 namespace isohex::detail {
+
+CountAxis::CountAxis(const MetricSummary& s, bool log) : log_scale(log) {
+  const auto& c = s.histogram.counts;
+  const std::size_t peak = c.empty() ? 0 : *std::max_element(c.begin(), c.end());
+  decades = peak > 0 ? std::ceil(std::log10(static_cast<double>(peak))) : 0;
+  ticks = linear_ticks(std::max<double>(static_cast<double>(peak), 1.0));
+}
+
+double CountAxis::frac(double count) const {
+  if (log_scale) return count > 0 ? (1 + std::log10(count)) / (1 + decades) : 0.0;
+  return count / std::max(ticks.back(), 1.0);
+}
+
+const char* bar_colour(const MetricSummary& s, double lo) {
+  if (s.metric != HexMetric::scaled_jacobian) return "#4477aa";
+  if (lo < 0) return "#cc3311";
+  if (lo < kQuestionableSJ) return "#ee7733";
+  return "#228833";
+}
 
 std::vector<double> linear_ticks(double top) {
   const double raw = top / 5;
