@@ -10,7 +10,7 @@
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/validate.hpp"
-#include "isohex/surface/smooth_surface.hpp"
+#include "isohex/surface/smooth_region.hpp"
 #include "isohex/quality/summary.hpp"
 #include "isohex/volume/volume_io.hpp"
 
@@ -40,6 +40,7 @@ struct Args {
   std::size_t header_bytes = 0;
   bool no_surface_smoothing = false, no_pillow = false, no_smooth = false;
   int surface_iterations = 30;
+  std::optional<double> feature_angle;
   int* threads = nullptr;
 };
 
@@ -70,39 +71,27 @@ Volume sample_shape(const Args& a, double& cell_size) {
   return sample(s, grid_from_cell_size(box, cell_size / 2));
 }
 
-// Smooths the boundary on each isosurface of the region in turn. Vertices of the other
-// surfaces and of the domain box are pinned, so each surface keeps its own vertices on it.
+// Smooths the boundary on each isosurface of the region in turn (smooth_region_surfaces).
 std::vector<SurfaceSmoothingReport> smooth_surfaces(const contour::Region& region, contour::ExtractResult& out,
-                                                    int iterations, bool guard_hexes, bool terminal) {
-  std::vector<SurfaceSmoothingReport> reports;
-  for (std::size_t k = 0; k < region.surfaces.size(); ++k) {
-    const IsoField* field = region.surfaces[k].field();
-    if (!field) {
-      reports.emplace_back();  // an analytic sphere: its vertices are exact already
-      continue;
-    }
+                                                    int iterations, double feature_angle, bool guard_hexes,
+                                                    bool terminal) {
+  SurfaceSmoothingOptions opt;
+  opt.iterations = iterations;
+  opt.guard_hexes = guard_hexes;
+  opt.field_crease_angle_degrees = feature_angle;
+  if (!guard_hexes) opt.interior_layers = 0;  // the hexes below are re-shaped after pillowing
+  return smooth_region_surfaces(region, out, opt, [&](std::size_t k) {
     if (terminal) fmt::print("  surface smoothing on {}...\n", region.surfaces[k].describe()), std::fflush(stdout);
-    SurfaceSmoothingOptions opt;
-    opt.iterations = iterations;
-    opt.guard_hexes = guard_hexes;
-    if (!guard_hexes) opt.interior_layers = 0;  // the hexes below are re-shaped after pillowing
-    opt.pinned.assign(out.mesh.points.size(), 0);
-    for (std::size_t v = 0; v < out.vertex_place.size(); ++v) {
-      const std::int8_t place = out.vertex_place[v];
-      opt.pinned[v] = place == contour::kBoxVertex || (place >= 0 && place != static_cast<std::int8_t>(k));
-    }
-    reports.push_back(smooth_surface(out.mesh, *field, opt));
-  }
-  return reports;
+  });
 }
 
 void print_smoothing(const contour::LevelSet& surface, const SurfaceSmoothingReport& s) {
   if (!surface.field()) return;
   fmt::print("surface smoothing on {}: {} iterations{}; boundary quad SJ min {:.4g} -> {:.4g}, mean {:.4g} -> {:.4g}, "
-             "< {}: {} -> {}; hexes inverted {} -> {}\n",
+             "< {}: {} -> {}; hexes inverted {} -> {}; max-min: {} passes, {} moves\n",
              surface.describe(), s.iterations, s.converged ? " (converged)" : "", s.before.quad_sj_min,
              s.after.quad_sj_min, s.before.quad_sj_mean, s.after.quad_sj_mean, kQuestionableSJ, s.before.quads_below,
-             s.after.quads_below, s.before.hexes_inverted, s.after.hexes_inverted);
+             s.after.quads_below, s.before.hexes_inverted, s.after.hexes_inverted, s.worst_passes, s.worst_moves);
 }
 
 nlohmann::json smoothing_json(const contour::LevelSet& surface, const SurfaceSmoothingReport& s) {
@@ -113,7 +102,8 @@ nlohmann::json smoothing_json(const contour::LevelSet& surface, const SurfaceSmo
   };
   return {{"surface", surface.describe()}, {"smoothed", surface.field() != nullptr}, {"iterations", s.iterations},
           {"converged", s.converged}, {"before", q(s.before)}, {"after", q(s.after)},
-          {"max_level_relative", s.max_level_relative}, {"max_displacement", s.max_displacement}};
+          {"max_level_relative", s.max_level_relative}, {"max_displacement", s.max_displacement},
+          {"max_min_passes", s.worst_passes}, {"max_min_moves", s.worst_moves}};
 }
 
 void print_summary(const MetricSummary& s) {
@@ -180,7 +170,9 @@ void run(const Args& a) {
   rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes));
   auto t = Clock::now();
   const std::vector<SurfaceSmoothingReport> smoothing =
-      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations, a.no_pillow, terminal);
+      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations,
+                                     // Scans have no sharp features: every crease of their quads is a fold.
+                                     a.feature_angle.value_or(a.shape.empty() ? 180.0 : 30.0), a.no_pillow, terminal);
   const double smooth_time = seconds_since(t);
   for (std::size_t k = 0; k < smoothing.size(); ++k) print_smoothing(region.surfaces[k], smoothing[k]);
   if (!a.no_surface_smoothing) {
@@ -223,9 +215,10 @@ void run(const Args& a) {
 
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
              out.mesh.num_hexes(), out.mesh.num_vertices(), r.surface_vertices, r.box_vertices, check.num_boundary_quads);
-  fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds ({} simple, topology kept; {} "
-             "forced); {} cells split\n",
-             r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.forced_points, r.split_cells);
+  fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds ({} simple and {} relocated, "
+             "topology kept; {} forced); {} cells split\n",
+             r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.relocated_points, r.forced_points,
+             r.split_cells);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -263,13 +256,18 @@ void run(const Args& a) {
     j["filled_points"] = r.filled_points;
     j["carved_points"] = r.carved_points;
     j["simple_points"] = r.simple_points;
+    j["relocated_points"] = r.relocated_points;
     j["forced_points"] = r.forced_points;
     // Every sample the repair flipped, so that the topology claims can be checked.
     nlohmann::json edits = nlohmann::json::array();
     for (const auto& e : r.edits) {
       const Vec3 x = r.grid.origin + r.grid.h * Vec3(static_cast<double>(e.point[0]), static_cast<double>(e.point[1]),
                                                      static_cast<double>(e.point[2]));
-      edits.push_back({{"grid", e.point}, {"position", {x[0], x[1], x[2]}}, {"inside", e.inside}, {"simple", e.simple}});
+      edits.push_back({{"grid", e.point}, {"position", {x[0], x[1], x[2]}}, {"inside", e.inside},
+                       {"simple", e.kind == contour::RepairKind::simple},
+                       {"kind", e.kind == contour::RepairKind::simple      ? "simple"
+                                : e.kind == contour::RepairKind::relocated ? "relocated"
+                                                                           : "forced"}});
     }
     j["repair_edits"] = edits;
     j["split_cells"] = r.split_cells;
@@ -333,6 +331,10 @@ void register_mesh(CLI::App& app) {
                 "Skip the geometric-flow smoothing of the boundary quads (on by default; vertices stay on the isosurface)");
   cmd->add_option("--surface-iterations", a->surface_iterations, "Iterations of the surface smoothing (default 30)")
       ->check(CLI::Range(0, 10000));
+  cmd->add_option("--feature-angle", a->feature_angle,
+                  "Surface smoothing keeps creases where the isosurface's normal turns by more than this (degrees; "
+                  "default 30 for --shape, 180 = none for volumes: creases of a scan's quads are folds to unfold)")
+      ->check(CLI::Range(0.0, 180.0));
   cmd->add_flag("--no-pillow", a->no_pillow,
                 "Skip boundary pillowing (on by default: a sheet of hexes inside the boundary, surface unchanged)");
   cmd->add_flag("--no-smooth", a->no_smooth,

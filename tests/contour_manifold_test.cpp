@@ -94,12 +94,12 @@ DigitalTopology digital_topology(const std::vector<std::uint8_t>& in, Index n) {
 }
 
 // Flags of the volume's points (value > 0.5) with the repair's edits applied: all of them,
-// or only the simple ones.
+// or only those that keep the topology (simple and relocated).
 std::vector<std::uint8_t> repaired_flags(const Volume& v, const ExtractReport& r, bool simple_only) {
   std::vector<std::uint8_t> in(v.values.size());
   for (std::size_t i = 0; i < in.size(); ++i) in[i] = v.values[i] > 0.5f;
   for (const auto& e : r.edits)
-    if (e.simple || !simple_only)
+    if (e.keeps_topology() || !simple_only)
       in[static_cast<std::size_t>(e.point[0] + v.dims[0] * (e.point[1] + v.dims[1] * e.point[2]))] = e.inside;
   return in;
 }
@@ -162,22 +162,69 @@ TEST(ContourManifold, CubesSharingAVertexAreSeparated) {
   EXPECT_EQ(m.check.euler_characteristic, 4);
 }
 
-TEST(ContourManifold, CavitiesTouchingAtAVertexAreRepaired) {
-  // A 6^3 solid with two single-voxel cavities meeting at a vertex: marching cubes sees two
-  // cavities, but no conformal mesh with one hex per inside point can, and every flip changes
-  // the topology: the repair's forced phase fills one cavity.
-  std::vector<std::array<Index, 3>> in;
+// A 6^3 solid with the listed one-voxel cavities.
+Volume block_with_cavities(const std::vector<std::array<Index, 3>>& cavities) {
+  Volume v = voxels(8, {});
   for (Index z = 1; z < 7; ++z)
     for (Index y = 1; y < 7; ++y)
-      for (Index x = 1; x < 7; ++x)
-        if (!(x == 3 && y == 3 && z == 3) && !(x == 4 && y == 4 && z == 4)) in.push_back({x, y, z});
-  const Meshed m = mesh_of(voxels(8, in));
+      for (Index x = 1; x < 7; ++x) v.at(x, y, z) = 1.0f;
+  for (const auto& c : cavities) v.at(c[0], c[1], c[2]) = 0.0f;
+  return v;
+}
+
+TEST(ContourManifold, CavitiesTouchingAtAVertexAreKeptByMovingOne) {
+  // Two single-voxel cavities meeting at a vertex (a cell's body diagonal): marching cubes
+  // sees two cavities, but no conformal mesh with one hex per inside point can have them
+  // there, and every single flip changes the topology. The repair moves one cavity: (3, 3, 3)
+  // is made inside and (2, 2, 2), the first place within 2 samples whose 26 neighbours are
+  // then all inside, outside. Outer surface and two cavities: 3 spheres.
+  const Volume v = block_with_cavities({{3, 3, 3}, {4, 4, 4}});
+  const Meshed m = mesh_of(v);
   expect_closed_manifold(m);
-  EXPECT_EQ(m.result.report.filled_points, 1u);
-  EXPECT_EQ(m.result.report.forced_points, 1u);
-  EXPECT_EQ(m.result.report.simple_points, 0u);
-  EXPECT_EQ(m.check.num_boundary_components, 2u);  // the outer surface and one cavity
-  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 1);
+  const ExtractReport& r = m.result.report;
+  EXPECT_EQ(r.forced_points, 0u);
+  EXPECT_EQ(r.simple_points, 0u);
+  EXPECT_EQ(r.relocated_points, 2u);
+  ASSERT_EQ(r.edits.size(), 2u);
+  EXPECT_EQ(r.edits[0].point, (std::array<Index, 3>{3, 3, 3}));
+  EXPECT_TRUE(r.edits[0].inside);
+  EXPECT_EQ(r.edits[1].point, (std::array<Index, 3>{2, 2, 2}));
+  EXPECT_FALSE(r.edits[1].inside);
+  EXPECT_EQ(r.edits[0].kind, RepairKind::relocated);
+  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 2);
+  EXPECT_EQ(m.check.num_boundary_components, 3u);
+  EXPECT_EQ(m.check.euler_characteristic, 6);
+  std::vector<std::uint8_t> before(v.values.size());
+  for (std::size_t i = 0; i < before.size(); ++i) before[i] = v.values[i] > 0.5f;
+  EXPECT_EQ(digital_topology(repaired_flags(v, r, false), 8), digital_topology(before, 8));
+  // The moved cavity's vertices are still on the isosurface (around the filled point).
+  RegionSpec spec;
+  spec.isovalue = 0.5;
+  const SurfaceDistance d = surface_distance(make_region(v, spec), m.result.mesh, m.result.vertex_place);
+  EXPECT_LE(d.max_relative, 1e-6);
+}
+
+TEST(ContourManifold, ThreeCavitiesOnADiagonalKeepTheirTopology) {
+  // A chain of three cavities touching at vertices: the outer ones have nowhere to go within
+  // 2 samples that touches neither of the others, so the middle one is moved off the
+  // diagonal; four spheres in all.
+  const Volume v = block_with_cavities({{2, 2, 2}, {3, 3, 3}, {4, 4, 4}});
+  const Meshed m = mesh_of(v);
+  expect_closed_manifold(m);
+  EXPECT_EQ(m.result.report.forced_points, 0u);
+  EXPECT_EQ(m.check.num_boundary_components, 4u);
+  EXPECT_EQ(m.check.euler_characteristic, 8);
+  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 3);
+}
+
+TEST(ContourManifold, IslandsTouchingAtAVertexNeedNoRepair) {
+  // The complement: two single inside points meeting at a vertex in the outside. Each cell
+  // gives each its own dual vertex, so nothing is flipped: two cubes, as marching cubes has.
+  const Meshed m = mesh_of(voxels(6, {{2, 2, 2}, {3, 3, 3}}));
+  expect_closed_manifold(m);
+  EXPECT_TRUE(m.result.report.edits.empty());
+  EXPECT_EQ(m.check.num_boundary_components, 2u);
+  EXPECT_EQ(m.check.euler_characteristic, 4);
 }
 
 TEST(ContourManifold, CavitiesTouchingAlongAnEdgeAreJoined) {
@@ -326,7 +373,7 @@ TEST(ContourManifold, RandomVolumesAlwaysGiveManifolds) {
     // Simple flips keep marching cubes' topology of the samples; with every flip applied the
     // mesh has that topology: one boundary per inside part and per cavity.
     const ExtractReport& r = m.result.report;
-    EXPECT_EQ(r.simple_points + r.forced_points, r.edits.size());
+    EXPECT_EQ(r.simple_points + r.relocated_points + r.forced_points, r.edits.size());
     std::vector<std::uint8_t> before(v.values.size());
     for (std::size_t i = 0; i < before.size(); ++i) before[i] = v.values[i] > 0.5f;
     EXPECT_EQ(digital_topology(repaired_flags(v, r, true), n), digital_topology(before, n));

@@ -170,17 +170,17 @@ def hex_boundary(mesh_file):
 
 
 # The repair flips samples where an inside component's complement in a cell falls apart.
-# It flips simple points only (no change of marching cubes' topology), which the test checks
-# by running marching cubes on the samples with those flips applied. Where no short sequence
-# of simple flips exists, the flip is forced and may change the topology; the mesh must then
-# still match marching cubes on the samples with every flip applied, and the case is listed
-# here with the measured reason.
+# Simple flips and cavity moves (a one-sample cavity removed and made again nearby) keep
+# marching cubes' topology, which the test checks by running marching cubes on the samples
+# with those flips applied. Where neither finds a fix, the flip is forced and may change the
+# topology; the mesh must then still match marching cubes on the samples with every flip
+# applied, and the case is listed here with the largest difference allowed (components,
+# Euler characteristic) and the measured reason, so that a regression still fails.
 KNOWN_TOPOLOGY_DIFFERENCES = {
-    "cthead": "3 forced flips, among them two pairs of one-sample cavities in the skull that touch at a cell's body "
-              "diagonal (MC: 2 separate cavities each; a mesh with one hex per inside sample cannot separate "
-              "them, and every flip of those samples changes the topology): 243 vs 245 components",
-    "cthead-h1": "39 forced flips of 1654 (no sequence of up to 5 simple flips found): Euler -236 vs -248, "
-                 "components equal (435)",
+    "cthead-h1": (0, 4, "4 forced flips of 1,655: two cells where two one-sample-thick pillars, each touching the "
+                       "other only along a cell edge, meet a solid slab (no sequence of simple flips up to 5 from the "
+                       "cell's corners, or of 3 prepared from its neighbours, mends them): Euler -244 vs -248, "
+                       "components equal (435)"),
 }
 # Both surfaces have their vertices on the isosurface and chord it in between; with one vertex
 # per cell instead of one per cell edge the quads chord it about 1.7 times deeper than marching
@@ -244,13 +244,13 @@ def main():
         rng = float(a.max() - a.min())
         mc = marching_cubes(a, spacing, origin, iso, h, rng)
         edits = report["repair_edits"]
-        simple = [e for e in edits if e["simple"]]
+        simple = [e for e in edits if e.get("kind", "simple" if e["simple"] else "forced") != "forced"]
         hb = hex_boundary(out)
         dv = abs(hb["volume"] - mc["volume"]) / mc["volume"]
         sj = report["scaled_jacobian"]
         print(f"{name}: {report['hexes']} hexes, SJ min {sj['min']:.3f} mean {sj['mean']:.3f} "
               f"<0 {sj['inverted']} <0.2 {sj['questionable']}; flips {len(report['repair_edits'])} "
-              f"({report['forced_points']} forced); "
+              f"({report.get('relocated_points', 0)} relocated, {report['forced_points']} forced); "
               f"volume {hb['volume']:.6g} vs MC {mc['volume']:.6g} ({100 * dv:.3f} %); components {hb['components']} "
               f"vs {mc['components']}; Euler {hb['euler']} vs {mc['euler']}; max dist {report['max_relative_distance']:.2g}; "
               f"box vertices {report['box_vertices']}")
@@ -266,7 +266,7 @@ def main():
         if simple:
             mc_simple = marching_cubes(a, spacing, origin, iso, h, rng, simple)
             if (mc_simple["components"], mc_simple["euler"]) != (mc["components"], mc["euler"]):
-                failures.append(f"{name}: the {len(simple)} simple flips change marching cubes' topology: components "
+                failures.append(f"{name}: the {len(simple)} simple and relocated flips change marching cubes' topology: components "
                                 f"{mc_simple['components']} vs {mc['components']}, Euler {mc_simple['euler']} vs {mc['euler']}")
         if len(simple) != len(edits):
             mc_all = marching_cubes(a, spacing, origin, iso, h, rng, edits)
@@ -275,10 +275,11 @@ def main():
             if (hb["components"], hb["euler"]) != (mc_all["components"], mc_all["euler"]):
                 failures.append(f"{name}: topology differs from marching cubes on the repaired samples: components "
                                 f"{hb['components']} vs {mc_all['components']}, Euler {hb['euler']} vs {mc_all['euler']}")
-        topo = (hb["components"], hb["euler"]) == (mc["components"], mc["euler"])
-        if not topo and name not in KNOWN_TOPOLOGY_DIFFERENCES:
+        dc, de = abs(hb["components"] - mc["components"]), abs(hb["euler"] - mc["euler"])
+        max_dc, max_de, _ = KNOWN_TOPOLOGY_DIFFERENCES.get(name, (0, 0, ""))
+        if dc > max_dc or de > max_de:
             failures.append(f"{name}: topology differs from marching cubes: components {hb['components']} vs "
-                            f"{mc['components']}, Euler {hb['euler']} vs {mc['euler']}")
+                            f"{mc['components']}, Euler {hb['euler']} vs {mc['euler']} (allowed: {max_dc}, {max_de})")
     for f in failures:
         print("FAIL", f)
     return 1 if failures else 0

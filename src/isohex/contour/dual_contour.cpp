@@ -287,6 +287,7 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   rep.filled_points = repaired.filled;
   rep.carved_points = repaired.carved;
   rep.simple_points = repaired.simple;
+  rep.relocated_points = repaired.relocated;
   rep.forced_points = repaired.forced;
   {
     // Each flip's new state, walking back from the final one (a point can flip more than once).
@@ -303,7 +304,7 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
       const std::size_t i = p % g.padded[0], j = p / g.padded[0] % g.padded[1], k = p / (g.padded[0] * g.padded[1]);
       // Padded index (I, J, K) is grid point (I - 1, J - 1, K - 1).
       rep.edits.push_back({{static_cast<Index>(i) - 1, static_cast<Index>(j) - 1, static_cast<Index>(k) - 1},
-                           state[e] != 0, repaired.edits[e].simple});
+                           state[e] != 0, repaired.edits[e].kind});
     }
   }
   rep.repair_rounds = repaired.rounds;

@@ -21,10 +21,12 @@
 /// apart and not held to the on-surface check, since the box face, not the isosurface, is
 /// the boundary there.
 ///
-/// Before vertices are placed, non-manifold cells are repaired (cell_cases.hpp): inside points
-/// are made outside where outside parts touch along an edge, then outside points inside where
-/// they touch at a vertex, each phase repeated until nothing changes (each is monotone, so
-/// the repair ends).
+/// Before vertices are placed, non-manifold cells are repaired (cell_cases.hpp,
+/// sampled_grid.hpp): by flips that keep marching cubes' topology of the samples (sequences of
+/// simple points, and moves of one-sample cavities), and where none exists by forced edits:
+/// inside points made outside where outside parts touch along an edge, then outside points
+/// inside where they touch at a vertex, each phase repeated until nothing changes (each is
+/// monotone, so the repair ends).
 /// Every stage is parallel (oneTBB) and writes disjoint parts of its output, and vertices
 /// and hexes are numbered in grid order, so the mesh is the same bit for bit for any number
 /// of threads.
@@ -53,6 +55,13 @@ struct DualGrid {
 /// grid is the volume's own grid.
 DualGrid make_grid(const Aabb& domain, double h);
 
+/// What a flip of the manifold repair is (ExtractReport::Edit, RepairCounts::Edit).
+enum class RepairKind : std::uint8_t {
+  simple,     ///< a simple point: marching cubes' topology of the samples kept
+  relocated,  ///< half of a moved one-sample cavity (removed here, made again nearby): topology kept
+  forced,     ///< a forced carve or fill: may change the topology
+};
+
 /// Where a mesh vertex lies (ExtractResult::vertex_place); values ≥ 0 name a surface of the
 /// region (an index into Region::surfaces).
 enum : std::int8_t { kInteriorVertex = -1, kBoxVertex = -2 };
@@ -72,14 +81,17 @@ struct ExtractReport {
   std::size_t filled_points = 0;       ///< made inside by the manifold repair
   std::size_t carved_points = 0;       ///< made outside by the manifold repair
   std::size_t simple_points = 0;       ///< of the filled and carved, simple points (topology kept)
+  std::size_t relocated_points = 0;    ///< of the filled and carved, flips that moved one-sample
+                                       ///< cavities, two per cavity (topology kept)
   std::size_t forced_points = 0;       ///< of the filled and carved, edits that may change topology
   /// Every flip of the repair in the order made: grid point (i, j, k), its state after the
-  /// flip (true = made inside), and whether it was simple. Applied to the samples, the simple
+  /// flip (true = made inside), and its kind. Applied to the samples, the simple and relocated
   /// ones keep marching cubes' topology and all of them give the mesh's topology.
   struct Edit {
     std::array<Index, 3> point;
     bool inside;
-    bool simple;
+    RepairKind kind;
+    [[nodiscard]] bool keeps_topology() const { return kind != RepairKind::forced; }
   };
   std::vector<Edit> edits;
   std::size_t repair_rounds = 0;

@@ -50,26 +50,48 @@ SampledGrid sample_region(const Region& region, const DualGrid& grid);
 
 /// What repair_manifold changed.
 struct RepairCounts {
-  std::size_t carved = 0;  ///< inside points made outside
-  std::size_t filled = 0;  ///< outside points made inside
-  std::size_t simple = 0;  ///< of those, simple points (no change of topology)
-  std::size_t forced = 0;  ///< of those, edits that may change the topology
+  std::size_t carved = 0;     ///< inside points made outside
+  std::size_t filled = 0;     ///< outside points made inside
+  std::size_t simple = 0;     ///< of those, simple points (no change of topology)
+  std::size_t relocated = 0;  ///< of those, flips moving one-sample cavities (two per move; topology kept)
+  std::size_t forced = 0;     ///< of those, edits that may change the topology
   struct Edit {
     std::size_t point;  ///< padded index
-    bool simple;
+    RepairKind kind;
   };
-  std::vector<Edit> edits;  ///< every flip, in the order made (simple ones first)
+  std::vector<Edit> edits;  ///< every flip, in the order made (forced ones last)
   std::size_t rounds = 0;
 };
 
-/// Makes the grid manifold. First it flips only simple points (is_simple_6_18), so the
-/// solid keeps the topology marching cubes gives the samples: in each non-manifold cell, a
-/// corner whose flip is simple and lowers the number of non-manifold cells around it, the
-/// one nearest the isosurface. What remains is forced, in two monotone phases: while some
-/// cell has outside parts touching along an edge, inside points are made outside
-/// (manifold_carve); then, while some cell is non-manifold, outside points are made inside
-/// (manifold_fill; this can create new edge contacts, which it fills too). Each phase ends;
-/// the result is the same for any thread count.
+/// Makes the grid manifold, keeping the topology marching cubes gives the samples wherever it
+/// can:
+///  1. short sequences of simple flips (is_simple_6_18): for each non-manifold cell, the
+///     shortest sequence of up to 5 simple flips, the first a corner of the cell and each next
+///     one a corner of a non-manifold cell beside the flip before, that lowers the number of
+///     non-manifold cells; the one nearest the isosurface (lowest Σ|level|);
+///  2. where none exists, the first of these that mends the cell:
+///     a. cavity moves: a corner of the cell that is a one-sample cavity (outside, its 18
+///        neighbours inside: a cavity of its own in marching cubes' topology) is made inside,
+///        and an inside point within 2 samples whose 26 neighbours are then all inside (so the
+///        new cavity merges with nothing and makes no non-manifold cell), next to the
+///        isosurface, is made outside: the pair with the lowest |level| sum. One cavity gone,
+///        an identical one made: components and Euler characteristic kept;
+///     b. prepared sequences: 2 or 3 simple flips, the last a corner of the cell and each
+///        earlier one a 26-neighbour of the next (it makes the next one simple: the tip of a
+///        one-sample-thick finger before its last point, a point beside a cavity before the
+///        cavity);
+///     c. the deep search: up to 32 simple flips, each mending the cell it is a corner of
+///        without raising the count (a defect walked along a structure: two one-sample-thick
+///        fingers joined at their base, zipped up to their tips), at most 20,000 simple-point
+///        tests per cell;
+///     then 1 again around what changed;
+///  3. forced edits, in two monotone phases: while some cell has outside parts touching
+///     along an edge, inside points are made outside (manifold_carve); then, while some cell
+///     is non-manifold, outside points are made inside (manifold_fill; this can create new
+///     edge contacts, which it fills too).
+/// Every step of 1 and 2 lowers the number of non-manifold cells, so the repair ends. Cells
+/// are taken in grid order and the searches are sequential, so the result is the same for
+/// any thread count.
 RepairCounts repair_manifold(SampledGrid& g);
 
 /// Labels the face-connected parts of the inside points (which are the connected parts of

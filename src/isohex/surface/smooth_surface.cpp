@@ -44,6 +44,11 @@ void check_inputs(const HexMesh& mesh, const IsoField& field, const SurfaceSmoot
     throw Error(fmt::format("surface smoothing: mesh.fixed has {} entries for {} vertices", mesh.fixed.size(), nv));
   if (!o.pinned.empty() && o.pinned.size() != mesh.points.size())
     throw Error(fmt::format("surface smoothing: the pinned mask has {} entries for {} vertices", o.pinned.size(), nv));
+  if (!o.planar.empty() && o.planar.size() != mesh.points.size())
+    throw Error(fmt::format("surface smoothing: the planar mask has {} entries for {} vertices", o.planar.size(), nv));
+  for (std::size_t v = 0; v < o.planar.size(); ++v)
+    if (o.planar[v] < -1 || o.planar[v] > 2)
+      throw Error(fmt::format("surface smoothing: planar[{}] = {} is not an axis (0-2) or -1", v, o.planar[v]));
 
   const Volume& vol = field.volume();
   if (vol.dims[0] < 2 || vol.dims[1] < 2 || vol.dims[2] < 2)
@@ -65,9 +70,14 @@ void check_inputs(const HexMesh& mesh, const IsoField& field, const SurfaceSmoot
   check_range("min_quad_sj", o.min_quad_sj, 0, 1);
   check_range("max_halvings", o.max_halvings, 0, 60);
   check_range("crease_angle_degrees", o.crease_angle_degrees, 1e-9, 180);
+  check_range("field_crease_angle_degrees", o.field_crease_angle_degrees, 0, 180);
   check_range("level_tolerance", o.level_tolerance, 1e-15, kSurfaceGuarantee);
   check_range("projection_reach", o.projection_reach, 1e-6, 100);
   check_range("convergence", o.convergence, 0, 1);
+  check_range("worst_passes", o.worst_passes, 0, 1e6);
+  check_range("worst_target", o.worst_target, 0, 1);
+  check_range("worst_radius", o.worst_radius, 1e-9, 2);
+  check_range("worst_levels", o.worst_levels, 1, 30);
 }
 
 // A boundary vertex more than a cell outside the grid sees a clamped field, constant along
@@ -116,22 +126,99 @@ void sweep(const std::vector<std::vector<Index>>& classes, std::vector<MoveOutco
   }
 }
 
+double quad_sj_of(const HexMesh& mesh, const Quad& q) {
+  return quad_scaled_jacobian({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
+}
+
+// Passes of max–min moves over the free boundary vertices of quads below the target, in
+// colour classes (no two vertices of a class share a quad), until a pass moves nothing.
+// Pinned vertices keep their place but their normals still orient their quads.
+void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding,
+                       const std::vector<std::uint8_t>& on_isosurface, const SurfaceSmoothingOptions& options,
+                       SurfaceSmoothingReport& report) {
+  const HexMesh& mesh = ctx.mesh;
+  std::vector<std::uint8_t> can_move(mesh.points.size(), 0);
+  for (Index v : sliding) can_move[v] = 1;
+  std::vector<MoveOutcome> outcome(mesh.points.size(), MoveOutcome::none);
+  for (int pass = 0; pass < options.worst_passes; ++pass) {
+    const std::vector<Vec3> turned = surface_detail::turned_over_quads(ctx, on_isosurface);
+    std::vector<std::uint8_t> active(mesh.points.size(), 0);
+    for (std::size_t i = 0; i < ctx.graph.quads.size(); ++i) {
+      const Quad& q = ctx.graph.quads[i];
+      if (turned[i].squaredNorm() > 0 || quad_sj_of(mesh, q) < options.worst_target)
+        for (Index v : q) active[v] = can_move[v];
+    }
+    std::vector<Index> work;
+    for (Index v : sliding)
+      if (active[v]) work.push_back(v);
+    if (work.empty()) break;
+    report.worst_passes = pass + 1;
+    std::size_t moved = 0;
+    for (const auto& cls : surface_detail::colour_classes(work, mesh, ctx.graph.vertex_hexes)) {
+      tbb::parallel_for(std::size_t{0}, cls.size(), [&](std::size_t i) {
+        outcome[cls[i]] =
+            surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius, options.worst_levels, turned);
+      });
+      for (Index v : cls) moved += outcome[v] == MoveOutcome::accepted;
+    }
+    report.worst_moves += moved;
+    if (moved == 0) break;
+  }
+}
+
 }  // namespace
 
 SurfaceQuality surface_quality(const HexMesh& mesh) { return quality_of(mesh, boundary_quads(mesh)); }
 
-std::vector<std::uint8_t> volume_box_vertices(const HexMesh& mesh, const Volume& volume, double relative_tolerance) {
-  const Vec3 lo = volume.origin, hi = volume.max_corner();
+namespace {
+
+// Per boundary vertex, a bit per box face it lies on (bit 2a: low side of axis a, 2a+1: high).
+std::vector<std::uint8_t> box_faces(const HexMesh& mesh, const Vec3& lo, const Vec3& hi, double relative_tolerance) {
   const double tol = relative_tolerance * (hi - lo).norm();
-  std::vector<std::uint8_t> mask(mesh.points.size(), 0);
+  std::vector<std::uint8_t> faces(mesh.points.size(), 0);
   const std::vector<std::uint8_t> boundary = boundary_vertex_mask(mesh);
   for (std::size_t v = 0; v < mesh.points.size(); ++v) {
     if (!boundary[v]) continue;
     const Vec3& p = mesh.points[v];
-    for (int a = 0; a < 3; ++a)
-      if (std::abs(p[a] - lo[a]) <= tol || std::abs(p[a] - hi[a]) <= tol) mask[v] = 1;
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(p[a] - lo[a]) <= tol) faces[v] |= static_cast<std::uint8_t>(1u << (2 * a));
+      if (std::abs(p[a] - hi[a]) <= tol) faces[v] |= static_cast<std::uint8_t>(1u << (2 * a + 1));
+    }
   }
+  return faces;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> volume_box_vertices(const HexMesh& mesh, const Volume& volume, double relative_tolerance) {
+  std::vector<std::uint8_t> mask = box_faces(mesh, volume.origin, volume.max_corner(), relative_tolerance);
+  for (std::uint8_t& m : mask) m = m != 0;
   return mask;
+}
+
+std::vector<std::int8_t> box_face_axes(const HexMesh& mesh, const Vec3& lo, const Vec3& hi, double relative_tolerance) {
+  const std::vector<std::uint8_t> faces = box_faces(mesh, lo, hi, relative_tolerance);
+  std::vector<std::int8_t> axis(faces.size(), -1);
+  for (std::size_t v = 0; v < faces.size(); ++v)
+    for (int a = 0; a < 3; ++a)
+      if (faces[v] == (1u << (2 * a)) || faces[v] == (1u << (2 * a + 1))) axis[v] = static_cast<std::int8_t>(a);
+  return axis;
+}
+
+// Internal plane codes (MoveContext::planar): the axis for a vertex whose quads all lie in its
+// plane, the axis + 3 for one on the rim where the plane meets the isosurface.
+std::vector<std::int8_t> plane_codes(const HexMesh& mesh, const surface_detail::SurfaceGraph& graph,
+                                     const std::vector<std::int8_t>& planar) {
+  std::vector<std::int8_t> code(planar);
+  for (std::size_t v = 0; v < code.size(); ++v) {
+    const int a = code[v];
+    if (a < 0) continue;
+    const auto& vq = graph.vertex_quads;
+    for (Index k = vq.offsets[v]; k < vq.offsets[v + 1]; ++k)
+      for (Index w : graph.quads[vq.ids[k]])
+        if (mesh.points[w][a] != mesh.points[v][a]) code[v] = static_cast<std::int8_t>(a + 3);
+  }
+  return code;
 }
 
 SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, const SurfaceSmoothingOptions& options) {
@@ -142,7 +229,17 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
     pinned[v] = (options.use_mesh_fixed && mesh.has_fixed() && mesh.fixed[v]) || (!options.pinned.empty() && options.pinned[v]);
 
   const double crease_cos = std::cos(options.crease_angle_degrees * std::numbers::pi / 180.0);
-  const surface_detail::SurfaceGraph graph = surface_detail::build_surface_graph(mesh, crease_cos);
+  // A feature must show in the field too: where DC quads fold over a smooth (if noisy)
+  // isosurface their normals jump but the field's do not, and the max-min pass must move them.
+  const double field_crease_cos = std::cos(options.field_crease_angle_degrees * std::numbers::pi / 180.0);
+  const auto field_normal = [&](Index v) {
+    Vec3 g;
+    field.level(mesh.points[v], g);
+    const double len = g.norm();
+    return len > 0 && std::isfinite(len) ? Vec3(-g / len) : Vec3::Zero();
+  };
+  const surface_detail::SurfaceGraph graph =
+      surface_detail::build_surface_graph(mesh, crease_cos, field_normal, field_crease_cos);
   const std::size_t outside_grid = pin_outside_grid(mesh, graph.on_boundary, pinned, field.volume());
 
   SurfaceSmoothingReport report;
@@ -186,7 +283,10 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
                   options.max_halvings,
                   options.level_tolerance * field.value_range(),
                   options.projection_reach,
-                  options.guard_hexes};
+                  options.guard_hexes,
+                  nullptr};
+  const std::vector<std::int8_t> codes = options.planar.empty() ? std::vector<std::int8_t>{} : plane_codes(mesh, graph, options.planar);
+  ctx.planar = &codes;
   const std::vector<Vec3> start = mesh.points;
   std::vector<double> curvature(static_cast<std::size_t>(nv), 0.0);
   std::vector<MoveOutcome> outcome(static_cast<std::size_t>(nv), MoveOutcome::none);
@@ -225,12 +325,21 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
     }
   }
 
+  std::vector<Index> sliding;  // features stay; folds that merely look like creases unfold
+  std::vector<std::uint8_t> on_isosurface(static_cast<std::size_t>(nv), 0);
+  for (Index v : boundary) {
+    if (!graph.on_feature[v]) sliding.push_back(v);
+    on_isosurface[v] = surface_detail::plane_axis(ctx, v) < 0 || surface_detail::on_rim(ctx, v);
+  }
+  worst_quad_passes(ctx, sliding, on_isosurface, options, report);
+
   // Whatever the iterations did (or if there were none), end on the isosurface where allowed.
   sweep(boundary_classes, outcome, report,
         [&](Index v) { return surface_detail::move_boundary_vertex(ctx, v, Vec3::Zero()); });
 
   const double guarantee = kSurfaceGuarantee * field.value_range();
   for (Index v : boundary) {
+    if (surface_detail::plane_axis(ctx, v) >= 0 && !surface_detail::on_rim(ctx, v)) continue;  // a box face, not the isosurface
     const double l = std::abs(field.level(mesh.points[v]));
     report.max_level = std::max(report.max_level, l);
     if (l > guarantee) ++report.off_surface;

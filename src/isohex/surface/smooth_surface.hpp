@@ -69,6 +69,11 @@ struct SurfaceSmoothingOptions {
   double min_quad_sj = 0.2;           ///< soft floor of the boundary quads' scaled Jacobian, in [0, 1]
   int max_halvings = 4;               ///< step-backs of a rejected move before dropping it (≥ 0)
   double crease_angle_degrees = 60;   ///< dihedral angle marking a crease, in (0, 180]; 180 = none
+  /// A crease is a *feature*, held also by the max–min pass, when the isosurface's normal
+  /// (−∇L) turns by more than this angle between the edge's ends, in [0, 180]: 0 = every
+  /// crease, 180 = none. The relaxation holds every crease; folds of the quads over a smooth
+  /// (if noisy) surface look like creases, and only the max–min pass can unfold them.
+  double field_crease_angle_degrees = 30;
   double level_tolerance = 1e-7;      ///< projection target |L| ≤ this × the field's value range, in (0, 1e-6]
   double projection_reach = 1.0;      ///< largest projection distance, × the vertex's mean boundary edge length
   double convergence = 1e-4;          ///< stop once no vertex moved more than this × the mean boundary edge length
@@ -76,8 +81,22 @@ struct SurfaceSmoothingOptions {
   /// pillow gives every boundary quad a new hex and the hexes below are re-shaped anyway,
   /// so only the surface's own quality matters, and the hexes' floors would block it.
   bool guard_hexes = true;
+  /// Passes of local max–min moves after the relaxation (0 = none): each boundary vertex of a
+  /// quad below `worst_target` searches its tangent plane for the point on the isosurface that
+  /// most raises the smallest scaled Jacobian of its quads (a quad facing inward counts as −2).
+  /// This is what unfolds boundary quads; the relaxation alone leaves them.
+  int worst_passes = 40;
+  double worst_target = 0.5;          ///< quads below this are worked on, in [0, 1]
+  double worst_radius = 0.5;          ///< first trial step, × the vertex's mean boundary edge, in (0, 2]
+  int worst_levels = 6;               ///< step halvings of the search, in [1, 30]
   bool use_mesh_fixed = true;         ///< treat `mesh.fixed` as pinned
   std::vector<std::uint8_t> pinned;   ///< optional mask, one per vertex: 1 = pinned (e.g. on a volume-box face)
+  /// Optional, one per vertex: −1, or the axis (0–2) of an axis-aligned plane through the
+  /// vertex that it must stay in (box_face_axes(): a face of the domain box where the box cuts
+  /// the solid). A vertex whose boundary quads all lie in that plane slides in the plane;
+  /// one on the rim where the plane meets the isosurface slides along that curve. Pinned
+  /// vertices stay pinned.
+  std::vector<std::int8_t> planar;
 };
 
 /// Scaled-Jacobian figures of a mesh and its boundary.
@@ -110,6 +129,8 @@ struct SurfaceSmoothingReport {
   std::size_t colours = 0;             ///< colour classes used (boundary + interior)
   std::size_t moves_halved = 0;        ///< accepted moves that needed at least one step-back
   std::size_t moves_dropped = 0;       ///< moves rejected after all step-backs
+  int worst_passes = 0;                ///< max–min passes run
+  std::size_t worst_moves = 0;         ///< max–min moves taken
 };
 
 /// Smooths the boundary of `mesh` on the isosurface of `field` and relaxes the hexes below
@@ -120,6 +141,13 @@ struct SurfaceSmoothingReport {
 /// outside the field's grid box are pinned (SurfaceSmoothingReport::outside_grid).
 SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field,
                                       const SurfaceSmoothingOptions& options = {});
+
+/// For each boundary vertex of `mesh` that lies on exactly one face of the box [lo, hi]
+/// (within `relative_tolerance` × the box diagonal), that face's axis (0–2); −1 for every
+/// other vertex, those on the box's edges and corners included. Feeds
+/// SurfaceSmoothingOptions::planar.
+std::vector<std::int8_t> box_face_axes(const HexMesh& mesh, const Vec3& lo, const Vec3& hi,
+                                       double relative_tolerance = 1e-9);
 
 /// The scaled-Jacobian figures smooth_surface() reports, for any mesh.
 SurfaceQuality surface_quality(const HexMesh& mesh);

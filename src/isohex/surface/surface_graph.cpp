@@ -28,14 +28,22 @@ Incidence pairs_to_csr(const std::vector<std::array<Index, 2>>& pairs, Index num
 
 }  // namespace
 
-SurfaceGraph build_surface_graph(const HexMesh& mesh, double crease_cos) {
+SurfaceGraph build_surface_graph(const HexMesh& mesh, double crease_cos, const std::function<Vec3(Index)>& vertex_normal,
+                                 double vertex_crease_cos) {
   SurfaceGraph g;
   const Index nv = mesh.num_vertices();
-  g.quads = boundary_quads(mesh);
+  const std::vector<QuadFace> faces = build_quads(mesh);
+  g.quads = boundary_quads(faces);
+  for (const QuadFace& f : faces)
+    if (f.is_boundary()) {
+      g.quad_hex.push_back(f.hex[0]);
+      g.quad_face.push_back(f.local[0]);
+    }
   g.vertex_quads = vertex_cells(g.quads, nv);
   g.vertex_hexes = vertex_hexes(mesh);
   g.on_boundary.assign(static_cast<std::size_t>(nv), 0);
   g.on_crease.assign(static_cast<std::size_t>(nv), 0);
+  g.on_feature.assign(static_cast<std::size_t>(nv), 0);
   for (const Quad& q : g.quads)
     for (Index v : q) g.on_boundary[v] = 1;
 
@@ -65,6 +73,8 @@ SurfaceGraph build_surface_graph(const HexMesh& mesh, double crease_cos) {
       crease = n0.dot(n1) < crease_cos;
     }
     if (crease) g.on_crease[a] = g.on_crease[b] = 1;
+    if (crease && (j - i != 2 || !vertex_normal || vertex_normal(a).dot(vertex_normal(b)) < vertex_crease_cos))
+      g.on_feature[a] = g.on_feature[b] = 1;
     i = j;
   }
   std::sort(neighbour_pairs.begin(), neighbour_pairs.end());

@@ -8,6 +8,7 @@
 #include "isohex/mesh/topology.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace isohex::surface_detail {
@@ -15,16 +16,23 @@ namespace isohex::surface_detail {
 /// Boundary adjacency of a hex mesh.
 struct SurfaceGraph {
   std::vector<Quad> quads;              ///< boundary quads, outward
+  std::vector<Index> quad_hex;          ///< per boundary quad, its hex
+  std::vector<std::int8_t> quad_face;   ///< per boundary quad, its face number in that hex (kHexFaces)
   Incidence vertex_quads;               ///< vertex → boundary quads (over all vertices)
   Incidence vertex_hexes;               ///< vertex → hexes
   Incidence boundary_neighbours;        ///< vertex → vertices joined to it by a boundary edge
   std::vector<std::uint8_t> on_boundary;  ///< 1 for boundary vertices
   std::vector<std::uint8_t> on_crease;    ///< 1 for ends of a crease or non-manifold boundary edge
+  std::vector<std::uint8_t> on_feature;   ///< 1 for ends of a crease that the vertex normals confirm (see below)
 };
 
 /// Builds the graph; `crease_cos` is the cosine of the crease angle (edges whose two quads'
-/// unit normals have a dot product below it are creases).
-SurfaceGraph build_surface_graph(const HexMesh& mesh, double crease_cos);
+/// unit normals have a dot product below it are creases). A crease is also a *feature* when
+/// `vertex_normal` (a unit normal per vertex, e.g. the isosurface's) turns by more than
+/// `vertex_crease_cos` between its two ends, or when no `vertex_normal` is given: a fold of
+/// the quads where the surface itself is smooth is no feature to keep.
+SurfaceGraph build_surface_graph(const HexMesh& mesh, double crease_cos,
+                                 const std::function<Vec3(Index)>& vertex_normal = {}, double vertex_crease_cos = 1);
 
 /// Interior vertices within `layers` hex layers of the boundary (a vertex sharing a hex with
 /// a boundary vertex is in layer 1), ascending, excluding those with `pinned` set.

@@ -36,18 +36,9 @@ double mean_boundary_edge(const MoveContext& ctx, Index v) {
   return n > 0 ? sum / n : 0.0;
 }
 
-// Projects y onto the isosurface; true when it got there.
-bool project(const MoveContext& ctx, Vec3& y, double reach) {
-  return ctx.field.project(y, reach, ctx.level_tolerance) && y.allFinite();
-}
-
 }  // namespace
 
-Vec3 outward_normal(const MoveContext& ctx, Index v) {
-  Vec3 g;
-  ctx.field.level(ctx.mesh.points[v], g);
-  const double len = g.norm();
-  if (len > 0 && std::isfinite(len)) return -g / len;
+Vec3 quads_normal(const MoveContext& ctx, Index v) {
   Vec3 n = Vec3::Zero();
   const auto& vq = ctx.graph.vertex_quads;
   const auto& p = ctx.mesh.points;
@@ -57,6 +48,46 @@ Vec3 outward_normal(const MoveContext& ctx, Index v) {
   }
   const double nl = n.norm();
   return nl > 0 ? Vec3(n / nl) : Vec3::Zero();
+}
+
+Vec3 outward_normal(const MoveContext& ctx, Index v) {
+  if (const int a = plane_axis(ctx, v); a >= 0) {
+    Vec3 n = Vec3::Zero();
+    n[a] = quads_normal(ctx, v)[a] < 0 ? -1.0 : 1.0;
+    return n;
+  }
+  Vec3 g;
+  ctx.field.level(ctx.mesh.points[v], g);
+  const double len = g.norm();
+  if (len > 0 && std::isfinite(len)) return -g / len;
+  return quads_normal(ctx, v);
+}
+
+bool constrain(const MoveContext& ctx, Index v, Vec3& y, double reach) {
+  const int a = plane_axis(ctx, v);
+  if (a < 0) return ctx.field.project(y, reach, ctx.level_tolerance) && y.allFinite();
+  y[a] = ctx.mesh.points[v][a];
+  if (!on_rim(ctx, v)) return y.allFinite();
+  // Newton steps along the gradient's in-plane part; bisection once the zero is bracketed.
+  const Vec3 start = y;
+  for (int it = 0; it < 30; ++it) {
+    Vec3 g;
+    const double l = ctx.field.level(y, g);
+    if (std::abs(l) <= ctx.level_tolerance) return y.allFinite();
+    g[a] = 0;
+    const double g2 = g.squaredNorm();
+    const double room = reach - (y - start).norm();
+    if (!(g2 > 0) || !(room > 0)) return false;
+    Vec3 step = -l * g / g2;
+    if (step.norm() > room) step *= room / step.norm();
+    const Vec3 z = y + step;
+    if ((ctx.field.level(z) > 0) != (l > 0)) {
+      y = ctx.field.root_on_segment(y, z, ctx.level_tolerance);
+      return std::abs(ctx.field.level(y)) <= ctx.level_tolerance && y.allFinite();
+    }
+    y = z;
+  }
+  return false;
 }
 
 Vec3 quad_umbrella(const MoveContext& ctx, Index v) {
@@ -152,7 +183,7 @@ bool move_is_acceptable(const MoveContext& ctx, Index v, const Vec3& y, bool bou
 
 MoveOutcome move_boundary_vertex(const MoveContext& ctx, Index v, const Vec3& step) {
   const Vec3 x = ctx.mesh.points[v];
-  const bool on_surface = std::abs(ctx.field.level(x)) <= ctx.level_tolerance;
+  const bool on_surface = (plane_axis(ctx, v) >= 0 && !on_rim(ctx, v)) || std::abs(ctx.field.level(x)) <= ctx.level_tolerance;
   const double reach = ctx.projection_reach * mean_boundary_edge(ctx, v);
   const bool has_step = step.squaredNorm() > 0 && step.allFinite();
   if (!has_step && on_surface) return MoveOutcome::none;
@@ -160,7 +191,7 @@ MoveOutcome move_boundary_vertex(const MoveContext& ctx, Index v, const Vec3& st
     double scale = 1;
     for (int k = 0; k <= ctx.max_halvings; ++k, scale *= 0.5) {
       Vec3 y = x + scale * step;
-      if (project(ctx, y, reach) && move_is_acceptable(ctx, v, y, true, Check::relax)) {
+      if (constrain(ctx, v, y, reach) && move_is_acceptable(ctx, v, y, true, Check::relax)) {
         ctx.mesh.points[v] = y;
         return k == 0 ? MoveOutcome::accepted : MoveOutcome::halved;
       }
@@ -168,7 +199,7 @@ MoveOutcome move_boundary_vertex(const MoveContext& ctx, Index v, const Vec3& st
   }
   if (!on_surface) {
     Vec3 y = x;
-    if (project(ctx, y, reach) && move_is_acceptable(ctx, v, y, true, Check::project)) {
+    if (constrain(ctx, v, y, reach) && move_is_acceptable(ctx, v, y, true, Check::project)) {
       ctx.mesh.points[v] = y;
       return has_step ? MoveOutcome::halved : MoveOutcome::accepted;
     }

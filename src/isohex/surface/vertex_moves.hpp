@@ -11,6 +11,7 @@
 #include "isohex/contour/iso_field.hpp"
 #include "isohex/surface/surface_graph.hpp"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -36,10 +37,33 @@ struct MoveContext {
   double level_tolerance;  ///< absolute |L| a projection aims for
   double projection_reach; ///< × the mean boundary edge length at the vertex
   bool guard_hexes = true;  ///< false: only the boundary quads are checked (a pillow follows)
+  /// Per vertex (or empty): −1; an axis a (0–2): the vertex slides in the plane x_a = const
+  /// through it (a domain-box face) instead of on the isosurface; a + 3: it slides along the
+  /// rim where that plane meets the isosurface.
+  const std::vector<std::int8_t>* planar = nullptr;
 };
 
+/// The axis of the plane `v` stays in, or −1.
+inline int plane_axis(const MoveContext& ctx, Index v) {
+  return ctx.planar && !ctx.planar->empty() ? (*ctx.planar)[static_cast<std::size_t>(v)] % 3 : -1;
+}
+
+/// True if `v` slides along the rim where its plane meets the isosurface.
+inline bool on_rim(const MoveContext& ctx, Index v) {
+  return ctx.planar && !ctx.planar->empty() && (*ctx.planar)[static_cast<std::size_t>(v)] >= 3;
+}
+
+/// Unit normal of the boundary at `v` from its quads (the sum of their area vectors).
+Vec3 quads_normal(const MoveContext& ctx, Index v);
+
+/// Puts `y`, a trial position of `v`, back on `v`'s surface within `reach`: its plane, the
+/// isosurface (IsoField::project), or the rim curve where both meet (Newton steps in the
+/// plane). True when it got there.
+bool constrain(const MoveContext& ctx, Index v, Vec3& y, double reach);
+
 /// Outward unit normal of the isosurface at boundary vertex `v` (−∇L normalised; the
-/// boundary quads' mean normal where the gradient vanishes).
+/// boundary quads' mean normal where the gradient vanishes); for a planar vertex, the
+/// plane's normal on the side its quads face.
 Vec3 outward_normal(const MoveContext& ctx, Index v);
 
 /// c_v − x_v, with c_v the area-weighted centroid of the boundary quads around `v`: the
@@ -79,5 +103,33 @@ MoveOutcome move_boundary_vertex(const MoveContext& ctx, Index v, const Vec3& st
 
 /// Moves interior vertex `v` by `step`, halving the step on rejection.
 MoveOutcome move_interior_vertex(const MoveContext& ctx, Index v, const Vec3& step);
+
+/// Value oriented_quad_sj() gives a quad that has turned over.
+inline constexpr double kFlippedQuad = -2.0;
+
+/// Verdict's quad scaled Jacobian of `c`, or kFlippedQuad when the quad's centre normal
+/// points against `reference` (a nonzero vector; zero = no check). Verdict's value is blind
+/// to orientation: a quad folded over onto its neighbour can score 1.
+double oriented_quad_sj(const std::array<Vec3, 4>& c, const Vec3& reference);
+
+/// One local max–min move of boundary vertex `v` on its surface (worst_moves.cpp): a compass
+/// search in the tangent plane (normal outward_normal()), 8 directions at steps of `radius`
+/// × the vertex's mean boundary edge, halved up to `levels` times; each trial point is put
+/// back on the surface by constrain(). Scores a trial by the smallest scaled Jacobian of the
+/// boundary quads around `v`, ties broken by their sum; a quad that would turn over from
+/// where it is now scores kFlippedQuad, and so does one with a nonzero `turned[q]` (one that
+/// has turned over: turned_over_quads()) until it faces that reference. Takes the best trial
+/// at the coarsest step that improves the score, so the minimum around `v` never decreases.
+/// With `guard_hexes` the hexes around `v` must keep their floors as in
+/// move_is_acceptable(). Returns dropped when no trial improves.
+MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int levels,
+                             const std::vector<Vec3>& turned);
+
+/// Per boundary quad, zero, or for a quad that faces inward an outward reference direction:
+/// a quad faces inward when its normal points against both the isosurface's outward normals
+/// at its corners that lie on the isosurface (`on_isosurface`) and the direction from the
+/// opposite face of its hex to it. Needing both keeps noisy gradients on thin features, and
+/// inverted hexes, from calling a quad turned over on their own.
+std::vector<Vec3> turned_over_quads(const MoveContext& ctx, const std::vector<std::uint8_t>& on_isosurface);
 
 }  // namespace isohex::surface_detail
