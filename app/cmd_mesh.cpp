@@ -88,16 +88,18 @@ std::vector<SurfaceSmoothingReport> smooth_surfaces(const contour::Region& regio
 void print_smoothing(const contour::LevelSet& surface, const SurfaceSmoothingReport& s) {
   if (!surface.field()) return;
   fmt::print("surface smoothing on {}: {} iterations{}; boundary quad SJ min {:.4g} -> {:.4g}, mean {:.4g} -> {:.4g}, "
-             "< {}: {} -> {}; hexes inverted {} -> {}; max-min: {} passes, {} moves\n",
+             "< {}: {} -> {}; fans < {}: {} -> {}; hexes inverted {} -> {}; max-min: {} passes, {} moves\n",
              surface.describe(), s.iterations, s.converged ? " (converged)" : "", s.before.quad_sj_min,
              s.after.quad_sj_min, s.before.quad_sj_mean, s.after.quad_sj_mean, kQuestionableSJ, s.before.quads_below,
-             s.after.quads_below, s.before.hexes_inverted, s.after.hexes_inverted, s.worst_passes, s.worst_moves);
+             s.after.quads_below, kQuestionableSJ, s.before.fans_below, s.after.fans_below, s.before.hexes_inverted,
+             s.after.hexes_inverted, s.worst_passes, s.worst_moves);
 }
 
 nlohmann::json smoothing_json(const contour::LevelSet& surface, const SurfaceSmoothingReport& s) {
   auto q = [](const SurfaceQuality& x) {
     return nlohmann::json{{"boundary_quad_sj_min", x.quad_sj_min}, {"boundary_quad_sj_mean", x.quad_sj_mean},
-                          {"boundary_quads_below_0.2", x.quads_below}, {"hex_sj_min", x.hex_sj_min},
+                          {"boundary_quads_below_0.2", x.quads_below}, {"fan_margin_min", x.fan_margin_min},
+                          {"fans_below_0.2", x.fans_below}, {"hex_sj_min", x.hex_sj_min},
                           {"hexes_inverted", x.hexes_inverted}};
   };
   return {{"surface", surface.describe()}, {"smoothed", surface.field() != nullptr}, {"iterations", s.iterations},
@@ -169,10 +171,10 @@ void run(const Args& a) {
   std::vector<StageRow> rows;
   rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes));
   auto t = Clock::now();
+  // Scans have no sharp features: every crease of their quads is a fold.
+  const double feature_angle = a.feature_angle.value_or(a.shape.empty() ? 180.0 : 30.0);
   const std::vector<SurfaceSmoothingReport> smoothing =
-      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations,
-                                     // Scans have no sharp features: every crease of their quads is a fold.
-                                     a.feature_angle.value_or(a.shape.empty() ? 180.0 : 30.0), a.no_pillow, terminal);
+      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations, feature_angle, a.no_pillow, terminal);
   const double smooth_time = seconds_since(t);
   for (std::size_t k = 0; k < smoothing.size(); ++k) print_smoothing(region.surfaces[k], smoothing[k]);
   if (!a.no_surface_smoothing) {
@@ -216,9 +218,9 @@ void run(const Args& a) {
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
              out.mesh.num_hexes(), out.mesh.num_vertices(), r.surface_vertices, r.box_vertices, check.num_boundary_quads);
   fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds ({} simple and {} relocated, "
-             "topology kept; {} forced); {} cells split\n",
+             "topology kept; {} forced; {} filling {} zero-volume cavities); {} cells split\n",
              r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.relocated_points, r.forced_points,
-             r.split_cells);
+             r.degenerate_points, r.degenerate_components, r.split_cells);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -258,6 +260,8 @@ void run(const Args& a) {
     j["simple_points"] = r.simple_points;
     j["relocated_points"] = r.relocated_points;
     j["forced_points"] = r.forced_points;
+    j["degenerate_components"] = r.degenerate_components;
+    j["degenerate_points"] = r.degenerate_points;
     // Every sample the repair flipped, so that the topology claims can be checked.
     nlohmann::json edits = nlohmann::json::array();
     for (const auto& e : r.edits) {
@@ -265,9 +269,10 @@ void run(const Args& a) {
                                                      static_cast<double>(e.point[2]));
       edits.push_back({{"grid", e.point}, {"position", {x[0], x[1], x[2]}}, {"inside", e.inside},
                        {"simple", e.kind == contour::RepairKind::simple},
-                       {"kind", e.kind == contour::RepairKind::simple      ? "simple"
-                                : e.kind == contour::RepairKind::relocated ? "relocated"
-                                                                           : "forced"}});
+                       {"kind", e.kind == contour::RepairKind::simple       ? "simple"
+                                : e.kind == contour::RepairKind::relocated  ? "relocated"
+                                : e.kind == contour::RepairKind::degenerate ? "degenerate"
+                                                                            : "forced"}});
     }
     j["repair_edits"] = edits;
     j["split_cells"] = r.split_cells;
@@ -285,6 +290,7 @@ void run(const Args& a) {
     nlohmann::json sm = nlohmann::json::array();
     for (std::size_t k = 0; k < smoothing.size(); ++k) sm.push_back(smoothing_json(region.surfaces[k], smoothing[k]));
     j["surface_smoothing"] = sm;
+    j["feature_angle_degrees"] = feature_angle;
     j["stages"] = stage_table_json(rows);
     if (!a.no_pillow) j["pillowing"] = pillowing;
     if (!a.no_smooth) j["optimisation"] = optimisation;

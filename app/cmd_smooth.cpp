@@ -1,6 +1,7 @@
 // isohex smooth IN -o OUT: untangle, then optimise shape (inverse mean ratio), then raise the
 // worst elements, with boundary / file-given / no vertices fixed.
 #include "commands.hpp"
+#include "mesh_stages.hpp"
 
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <unistd.h>
 
@@ -28,7 +30,7 @@ struct Args {
   bool untangle = false, skip_non_hex = false, no_worst = false, slide = false;
   double feature_angle = 30;
   FixedVertices fixed = FixedVertices::boundary;
-  int max_iter = 100;
+  std::optional<int> max_iter;  ///< unset: each stage's own limit (untangle 200, shape 100)
   double tol = 1e-5, margin = 0.05;
   int* threads = nullptr;
 };
@@ -74,13 +76,8 @@ void run(const Args& a) {
   print_quality("before", before);
 
   // Progress lines only on a terminal: logs and tests see the summaries alone.
-  const bool tty = isatty(fileno(stderr)) != 0;
   ProgressCallback progress;
-  if (tty)
-    progress = [](const IterationReport& r) {
-      fmt::print(stderr, "  {:<8} {:>4}  objective {:.6g}  min SJ {:.4f}  inverted {}\n", r.stage, r.iteration,
-                 r.objective, r.min_sj, r.inverted);
-    };
+  if (isatty(fileno(stderr)) != 0) progress = progress_printer(stderr);
 
   nlohmann::json report;
   report["input"] = a.in;
@@ -89,64 +86,23 @@ void run(const Args& a) {
   report["fixed_vertices"] = n_fixed;
   report["before"] = quality_json(before);
 
-  if (a.untangle) {
-    UntangleOptions uo;
-    uo.margin = a.margin;
-    uo.max_iter = std::max(a.max_iter, 1);
-    uo.progress = progress;
-    uo.surface = surface.get();
-    const UntangleResult u = untangle(mesh, fixed, uo);
-    nlohmann::json infeasible = nlohmann::json::array();
-    for (const InfeasibleSet& f : u.infeasible)
-      infeasible.push_back({{"kind", to_string(f.kind)}, {"vertex", f.vertex}, {"hexes", f.hexes}});
-    report["untangle"] = {{"iterations", u.iterations}, {"min_sj", u.min_sj},         {"inverted", u.inverted},
-                          {"reached_margin", u.reached_margin}, {"lp_moves", u.lp_moves}, {"infeasible", infeasible},
-                          {"given_up", u.given_up}};
-    if (!u.infeasible.empty()) {
-      // The proofs first: they explain why the exit code will be 1 whatever else happens.
-      fmt::print("untangle: {} sets of hexes cannot all be valid with these fixed vertices; {} hexes given up:\n",
-                 u.infeasible.size(), u.given_up.size());
-      for (std::size_t i = 0; i < u.infeasible.size() && i < 20; ++i) {
-        const InfeasibleSet& f = u.infeasible[i];
-        std::string ids;
-        for (Index h : f.hexes) ids += fmt::format(" {}", h);
-        if (f.kind == InfeasibleSet::Kind::fixed_frame)
-          fmt::print("  fixed_frame: hex{} has an inverted frame made of fixed vertices only\n", ids);
-        else
-          fmt::print("  vertex_cone: free vertex {} has no place keeping all of hexes{} valid\n", f.vertex, ids);
-      }
-      if (u.infeasible.size() > 20) fmt::print("  ... ({} more in the JSON report)\n", u.infeasible.size() - 20);
-    }
-    fmt::print("untangle: {} iterations{}, min SJ {:.4f}{}, inverted {}{}\n", u.iterations,
-               u.lp_moves ? fmt::format(" ({} LP moves)", u.lp_moves) : "", u.min_sj,
-               u.given_up.empty() ? "" : " (hexes not given up)", u.inverted,
-               u.reached_margin ? "" : fmt::format(" (margin {} not reached)", a.margin));
-  } else if (before.inverted + before.degenerate > 0) {
+  if (!a.untangle && before.inverted + before.degenerate > 0)
     fmt::print("note: {} inverted hexes are held as they are (use --untangle to repair them)\n",
                before.inverted + before.degenerate);
+  // The same sequence as `isohex mesh` (mesh_stages.cpp: run_optimisation); only the options
+  // given here differ from the defaults.
+  OptimizeOptions o;
+  o.untangle = a.untangle;
+  o.worst = !a.no_worst;
+  o.untangle_options.margin = a.margin;
+  if (a.max_iter) {
+    o.untangle_options.max_iter = std::max(*a.max_iter, 1);
+    o.shape_options.max_iter = *a.max_iter;
   }
-
-  ShapeOptions so;
-  so.max_iter = a.max_iter;
-  so.tol = a.tol;
-  so.progress = progress;
-  so.surface = surface.get();
-  const ShapeResult s = optimize_shape(mesh, fixed, so);
-  fmt::print("shape: {} sweeps, mean inverse mean ratio {:.6f} -> {:.6f}{}\n", s.iterations, s.objective_before,
-             s.objective_after, s.frozen_hexes ? fmt::format(" ({} invalid hexes held)", s.frozen_hexes) : "");
-  report["shape"] = {{"iterations", s.iterations}, {"objective_before", s.objective_before},
-                     {"objective_after", s.objective_after}, {"frozen_hexes", s.frozen_hexes}};
-
-  if (!a.no_worst) {
-    WorstOptions wo;
-    wo.progress = progress;
-    wo.surface = surface.get();
-    const WorstResult w = improve_worst(mesh, fixed, wo);
-    fmt::print("worst: {} passes, {} moves, min SJ {:.4f} -> {:.4f}\n", w.passes, w.moves, w.min_sj_before,
-               w.min_sj_after);
-    report["worst"] = {{"passes", w.passes}, {"moves", w.moves}, {"min_sj_before", w.min_sj_before},
-                       {"min_sj_after", w.min_sj_after}};
-  }
+  o.shape_options.tol = a.tol;
+  o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
+  o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
+  report.update(run_optimisation(mesh, fixed, o));
 
   const MetricSummary after = sj_summary(mesh);
   print_quality("after", after);
@@ -194,7 +150,9 @@ void register_smooth(CLI::App& app) {
   cmd->add_option("--feature-angle", a->feature_angle,
                   "With --boundary slide: boundary edges bent by more than this many degrees are features (default 30)")
       ->check(CLI::Range(0.0, 180.0));
-  cmd->add_option("--max-iter", a->max_iter, "Iteration limit of each stage (default 100)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--max-iter", a->max_iter,
+                  "Iteration limit of the untangler and the shape stage (default 200 and 100; the untangler "
+                  "usually stops earlier, when it stalls)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--tol", a->tol, "Stop the shape stage below this relative improvement per sweep (default 1e-5)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--margin", a->margin, "Untangling target for the minimum scaled Jacobian (default 0.05)");

@@ -34,37 +34,74 @@ nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_plac
   return j;
 }
 
+ProgressCallback progress_printer(std::FILE* out) {
+  return [out](const IterationReport& r) {
+    fmt::print(out, "  {:<8} {:>4}  objective {:.6g}  min SJ {:.4f}  inverted {}\n", r.stage, r.iteration, r.objective,
+               r.min_sj, r.inverted);
+    std::fflush(out);
+  };
+}
+
+nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options) {
+  const OptimizeResult r = optimize_mesh(mesh, fixed, options);
+  nlohmann::json j = nlohmann::json::object();
+  if (r.untangled) {
+    const UntangleResult& u = r.untangle;
+    nlohmann::json infeasible = nlohmann::json::array();
+    for (const InfeasibleSet& f : u.infeasible)
+      infeasible.push_back({{"kind", to_string(f.kind)}, {"vertex", f.vertex}, {"hexes", f.hexes}});
+    j["untangle"] = {{"iterations", u.iterations}, {"min_sj", u.min_sj},         {"inverted", u.inverted},
+                     {"reached_margin", u.reached_margin}, {"lp_moves", u.lp_moves}, {"infeasible", infeasible},
+                     {"given_up", u.given_up},             {"stuck", u.stuck},       {"stop", u.stop},
+                     {"seconds", r.untangle_seconds}};
+    if (!u.infeasible.empty()) {
+      // The proofs first: they explain why the exit code will be 1 whatever else happens.
+      fmt::print("untangle: {} sets of hexes cannot all be valid with these fixed vertices; {} hexes given up:\n",
+                 u.infeasible.size(), u.given_up.size());
+      for (std::size_t i = 0; i < u.infeasible.size() && i < 20; ++i) {
+        const InfeasibleSet& f = u.infeasible[i];
+        std::string ids;
+        for (Index h : f.hexes) ids += fmt::format(" {}", h);
+        if (f.kind == InfeasibleSet::Kind::fixed_frame)
+          fmt::print("  fixed_frame: hex{} has an inverted frame made of fixed vertices only\n", ids);
+        else
+          fmt::print("  vertex_cone: free vertex {} has no place keeping all of hexes{} valid\n", f.vertex, ids);
+      }
+      if (u.infeasible.size() > 20) fmt::print("  ... ({} more in the JSON report)\n", u.infeasible.size() - 20);
+    }
+    const char* why = u.stop == "margin" ? "" : u.stop == "stall" ? ", stopped: no progress" : ", stopped: iteration limit";
+    fmt::print("untangle: {} iterations{}{}, min SJ {:.4f}{}, inverted {}{}{}, {:.2f} s\n", u.iterations,
+               u.lp_moves ? fmt::format(" ({} LP moves)", u.lp_moves) : "", why, u.min_sj,
+               u.given_up.empty() ? "" : " (hexes not given up)", u.inverted,
+               u.stuck.empty() ? "" : fmt::format(" ({} stuck)", u.stuck.size()),
+               u.reached_margin ? "" : fmt::format(" (margin {} not reached)", options.untangle_options.margin),
+               r.untangle_seconds);
+  }
+  const ShapeResult& s = r.shape;
+  fmt::print("shape: {} sweeps, mean inverse mean ratio {:.6f} -> {:.6f}{}\n", s.iterations, s.objective_before,
+             s.objective_after, s.frozen_hexes ? fmt::format(" ({} invalid hexes held)", s.frozen_hexes) : "");
+  j["shape"] = {{"iterations", s.iterations}, {"objective_before", s.objective_before},
+                {"objective_after", s.objective_after}, {"frozen_hexes", s.frozen_hexes}, {"seconds", r.shape_seconds}};
+  if (r.worst_run) {
+    const WorstResult& w = r.worst;
+    fmt::print("worst: {} passes, {} moves, min SJ {:.4f} -> {:.4f}\n", w.passes, w.moves, w.min_sj_before,
+               w.min_sj_after);
+    j["worst"] = {{"passes", w.passes},           {"moves", w.moves},         {"min_sj_before", w.min_sj_before},
+                  {"min_sj_after", w.min_sj_after}, {"seconds", r.worst_seconds}};
+  }
+  return j;
+}
+
 nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left) {
   const std::vector<std::uint8_t> fixed = fixed_mask(mesh, FixedVertices::boundary);
-  ProgressCallback progress;
-  if (terminal)
-    progress = [](const IterationReport& r) {
-      fmt::print("  {:<8} {:>4}  objective {:.6g}  min SJ {:.4f}  inverted {}\n", r.stage, r.iteration, r.objective,
-                 r.min_sj, r.inverted);
-      std::fflush(stdout);
-    };
-  nlohmann::json j;
-  UntangleOptions uo;
-  uo.progress = progress;
-  const UntangleResult u = untangle(mesh, fixed, uo);
-  fmt::print("untangle: {} iterations, min SJ {:.4f}, inverted {}{}\n", u.iterations, u.min_sj, u.inverted,
-             u.infeasible.empty() ? "" : fmt::format(" ({} hexes cannot be valid with the boundary fixed)", u.given_up.size()));
-  j["untangle"] = {{"iterations", u.iterations}, {"min_sj", u.min_sj}, {"inverted", u.inverted},
-                   {"reached_margin", u.reached_margin}, {"given_up", u.given_up}};
-  ShapeOptions so;
-  so.progress = progress;
-  const ShapeResult s = optimize_shape(mesh, fixed, so);
-  fmt::print("shape: {} sweeps, mean inverse mean ratio {:.6f} -> {:.6f}\n", s.iterations, s.objective_before,
-             s.objective_after);
-  j["shape"] = {{"iterations", s.iterations}, {"objective_before", s.objective_before},
-                {"objective_after", s.objective_after}};
-  WorstOptions wo;
-  wo.progress = progress;
-  const WorstResult w = improve_worst(mesh, fixed, wo);
-  fmt::print("worst: {} passes, {} moves, min SJ {:.4f} -> {:.4f}\n", w.passes, w.moves, w.min_sj_before, w.min_sj_after);
-  j["worst"] = {{"passes", w.passes}, {"moves", w.moves}, {"min_sj_before", w.min_sj_before},
-                {"min_sj_after", w.min_sj_after}};
-  inverted_left = u.inverted;
+  OptimizeOptions o;
+  if (terminal) {
+    const ProgressCallback progress = progress_printer(stdout);
+    o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
+  }
+  nlohmann::json j = run_optimisation(mesh, fixed, o);
+  const MetricSummary s = summarize(HexMetric::scaled_jacobian, scaled_jacobians(mesh), 0);
+  inverted_left = s.inverted + s.degenerate;
   return j;
 }
 

@@ -3,11 +3,13 @@
 // untangling + shape optimisation with the boundary fixed, and the per-stage summary table.
 
 #include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/optimize/optimize.hpp"
 #include "isohex/quality/summary.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -31,9 +33,17 @@ StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds)
 /// vertices, which are interior. Returns the JSON facts of the stage.
 nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, bool terminal);
 
-/// Untangling, inverse-mean-ratio optimisation and the worst-element pass with the boundary
-/// fixed. Returns the JSON facts of the stage; `inverted_left` is set to the hexes still
-/// inverted.
+/// A progress callback printing one line per iteration to `out` (flushed).
+ProgressCallback progress_printer(std::FILE* out);
+
+/// The optimisation sequence of `isohex smooth` and `isohex mesh` (optimize_mesh(): untangle,
+/// shape, worst pass) with its printed lines (the untangler's proofs, first 20, and stop
+/// reason; shape; worst). Returns the JSON facts ("untangle", "shape", "worst").
+nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options);
+
+/// `isohex mesh`'s stage: run_optimisation() with the boundary fixed and default options (the
+/// same as `isohex smooth --untangle`). Returns the JSON facts of the stage; `inverted_left` is
+/// set to the hexes still inverted or degenerate at the end.
 nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left);
 
 /// Prints the table of rows (hexes, vertices, min/mean SJ, #<0, #<0.2, time).

@@ -3,12 +3,14 @@
 // consistently oriented 2-manifold and the mesh conformal).
 #include "isohex/contour/cell_cases.hpp"
 #include "isohex/contour/dual_contour.hpp"
+#include "isohex/mesh/topology.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/quality/hex_quality.hpp"
 
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <cstdlib>
 #include <random>
 #include <vector>
@@ -204,6 +206,108 @@ TEST(ContourManifold, CavitiesTouchingAtAVertexAreKeptByMovingOne) {
   EXPECT_LE(d.max_relative, 1e-6);
 }
 
+// Boundary quads whose 4 vertices coincide (zero area, all edges of length 0).
+std::size_t collapsed_boundary_quads(const HexMesh& mesh) {
+  std::size_t n = 0;
+  for (const Quad& q : boundary_quads(mesh)) {
+    bool all = true;
+    for (int c = 1; c < 4; ++c) all = all && mesh.points[static_cast<std::size_t>(q[c])] == mesh.points[static_cast<std::size_t>(q[0])];
+    n += all;
+  }
+  return n;
+}
+
+TEST(ContourManifold, ZeroVolumeCavityIsFilled) {
+  // Two one-sample cavities in a 6^3 solid: (4, 4, 4) below the isovalue (a real cavity, a
+  // small octahedron), (2, 2, 2) exactly at it (L == 0, outside): its isosurface is that one
+  // point, and dual contouring would put all 8 vertices around it there, a closed boundary of
+  // 6 collapsed quads. It is filled; the real one is kept.
+  Volume v = block_with_cavities({{4, 4, 4}});
+  v.at(2, 2, 2) = 0.5f;
+  const Meshed m = mesh_of(v);
+  expect_closed_manifold(m);
+  const ExtractReport& r = m.result.report;
+  EXPECT_EQ(r.degenerate_components, 1u);
+  EXPECT_EQ(r.degenerate_points, 1u);
+  EXPECT_EQ(r.filled_points, 1u);
+  EXPECT_EQ(r.forced_points, 0u);
+  ASSERT_EQ(r.edits.size(), 1u);
+  EXPECT_EQ(r.edits[0].point, (std::array<Index, 3>{2, 2, 2}));
+  EXPECT_TRUE(r.edits[0].inside);
+  EXPECT_EQ(r.edits[0].kind, RepairKind::degenerate);
+  EXPECT_FALSE(r.edits[0].keeps_topology());
+  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 1);
+  EXPECT_EQ(m.check.num_boundary_components, 2u);  // the outer surface and the real cavity
+  EXPECT_EQ(m.check.euler_characteristic, 4);
+  EXPECT_EQ(collapsed_boundary_quads(m.result.mesh), 0u);
+  for (double sj : scaled_jacobians(m.result.mesh)) EXPECT_FALSE(is_degenerate(sj));
+  RegionSpec spec;
+  spec.isovalue = 0.5;
+  const SurfaceDistance d = surface_distance(make_region(v, spec), m.result.mesh, m.result.vertex_place);
+  EXPECT_LE(d.max_relative, 1e-6);
+  EXPECT_EQ(d.off_surface, 0u);
+}
+
+TEST(ContourManifold, CavityJustBelowTheIsovalueIsKept) {
+  // Only exact zeros count: the same solid with that point one float below the isovalue has
+  // two real cavities (tiny, but with a volume), both kept.
+  Volume v = block_with_cavities({{4, 4, 4}});
+  v.at(2, 2, 2) = std::nextafter(0.5f, 0.0f);
+  const Meshed m = mesh_of(v);
+  expect_closed_manifold(m);
+  EXPECT_EQ(m.result.report.degenerate_components, 0u);
+  EXPECT_TRUE(m.result.report.edits.empty());
+  EXPECT_EQ(m.check.num_boundary_components, 3u);
+  EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 2);
+}
+
+TEST(ContourManifold, LargerZeroCavitiesAreFilledOnlyWithoutVolume) {
+  // Two face-adjacent samples at the isovalue: a segment, no volume: filled as one cavity.
+  {
+    Volume v = block_with_cavities({});
+    v.at(3, 3, 3) = 0.5f;
+    v.at(4, 3, 3) = 0.5f;
+    const Meshed m = mesh_of(v);
+    expect_closed_manifold(m);
+    EXPECT_EQ(m.result.report.degenerate_components, 1u);
+    EXPECT_EQ(m.result.report.degenerate_points, 2u);
+    EXPECT_EQ(m.check.num_boundary_components, 1u);
+    EXPECT_EQ(collapsed_boundary_quads(m.result.mesh), 0u);
+  }
+  // A 2 x 2 x 2 block at the isovalue: L == 0 throughout its cell, a cube-shaped cavity with
+  // a real volume: kept.
+  {
+    Volume v = block_with_cavities({});
+    for (Index z = 3; z < 5; ++z)
+      for (Index y = 3; y < 5; ++y)
+        for (Index x = 3; x < 5; ++x) v.at(x, y, z) = 0.5f;
+    const Meshed m = mesh_of(v);
+    expect_closed_manifold(m);
+    EXPECT_EQ(m.result.report.degenerate_components, 0u);
+    EXPECT_EQ(m.check.num_boundary_components, 2u);
+    EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 8);
+  }
+  // A sample at the isovalue next to (across a face diagonal) one below it: one cavity with a
+  // volume, kept whole.
+  {
+    Volume v = block_with_cavities({{4, 4, 3}});
+    v.at(3, 3, 3) = 0.5f;
+    const Meshed m = mesh_of(v);
+    expect_closed_manifold(m);
+    EXPECT_EQ(m.result.report.degenerate_components, 0u);
+    EXPECT_EQ(m.check.num_boundary_components, 2u);
+  }
+  // A sample at the isovalue on the solid's outer surface is not a cavity: kept.
+  {
+    Volume v = block_with_cavities({});
+    v.at(1, 3, 3) = 0.5f;
+    const Meshed m = mesh_of(v);
+    expect_closed_manifold(m);
+    EXPECT_EQ(m.result.report.degenerate_components, 0u);
+    EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 1);
+  }
+}
+
 TEST(ContourManifold, ThreeCavitiesOnADiagonalKeepTheirTopology) {
   // A chain of three cavities touching at vertices: the outer ones have nowhere to go within
   // 2 samples that touches neither of the others, so the middle one is moved off the
@@ -373,7 +477,7 @@ TEST(ContourManifold, RandomVolumesAlwaysGiveManifolds) {
     // Simple flips keep marching cubes' topology of the samples; with every flip applied the
     // mesh has that topology: one boundary per inside part and per cavity.
     const ExtractReport& r = m.result.report;
-    EXPECT_EQ(r.simple_points + r.relocated_points + r.forced_points, r.edits.size());
+    EXPECT_EQ(r.simple_points + r.relocated_points + r.forced_points + r.degenerate_points, r.edits.size());
     std::vector<std::uint8_t> before(v.values.size());
     for (std::size_t i = 0; i < before.size(); ++i) before[i] = v.values[i] > 0.5f;
     EXPECT_EQ(digital_topology(repaired_flags(v, r, true), n), digital_topology(before, n));

@@ -289,6 +289,8 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   rep.simple_points = repaired.simple;
   rep.relocated_points = repaired.relocated;
   rep.forced_points = repaired.forced;
+  rep.degenerate_components = repaired.degenerate_components;
+  rep.degenerate_points = repaired.degenerate;
   {
     // Each flip's new state, walking back from the final one (a point can flip more than once).
     std::vector<std::uint8_t> state(repaired.edits.size());

@@ -60,6 +60,8 @@ enum class RepairKind : std::uint8_t {
   simple,     ///< a simple point: marching cubes' topology of the samples kept
   relocated,  ///< half of a moved one-sample cavity (removed here, made again nearby): topology kept
   forced,     ///< a forced carve or fill: may change the topology
+  degenerate, ///< a fill of a zero-volume cavity (every sample at L == 0): removes a surface of zero
+              ///< volume, and of zero area for fewer than 4 samples, which would give collapsed quads
 };
 
 /// Where a mesh vertex lies (ExtractResult::vertex_place); values ≥ 0 name a surface of the
@@ -84,14 +86,17 @@ struct ExtractReport {
   std::size_t relocated_points = 0;    ///< of the filled and carved, flips that moved one-sample
                                        ///< cavities, two per cavity (topology kept)
   std::size_t forced_points = 0;       ///< of the filled and carved, edits that may change topology
+  std::size_t degenerate_components = 0;  ///< zero-volume cavities filled (all samples at L == 0)
+  std::size_t degenerate_points = 0;      ///< of the filled, their samples
   /// Every flip of the repair in the order made: grid point (i, j, k), its state after the
   /// flip (true = made inside), and its kind. Applied to the samples, the simple and relocated
-  /// ones keep marching cubes' topology and all of them give the mesh's topology.
+  /// ones keep marching cubes' topology and all of them give the mesh's topology; the
+  /// degenerate ones (first) remove only surfaces of zero volume.
   struct Edit {
     std::array<Index, 3> point;
     bool inside;
     RepairKind kind;
-    [[nodiscard]] bool keeps_topology() const { return kind != RepairKind::forced; }
+    [[nodiscard]] bool keeps_topology() const { return kind == RepairKind::simple || kind == RepairKind::relocated; }
   };
   std::vector<Edit> edits;
   std::size_t repair_rounds = 0;

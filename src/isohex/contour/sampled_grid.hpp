@@ -7,6 +7,7 @@
 #include "isohex/contour/dual_contour.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -21,8 +22,8 @@ struct SampledGrid {
   Aabb domain;
   std::array<std::size_t, 3> padded{3, 3, 3};  ///< points per axis, padding included
   std::vector<std::uint8_t> inside;             ///< 1 = inside, x fastest
-  /// min_k L_k at each point as sampled (0 on padding and where NaN); the repair flips the
-  /// points nearest the isosurface (lowest |level|).
+  /// min_k L_k at each point as sampled (+0 on padding and where L == 0 exactly, -0 where NaN);
+  /// the repair flips the points nearest the isosurface (lowest |level|).
   std::vector<float> level;
 
   [[nodiscard]] std::size_t index(std::size_t i, std::size_t j, std::size_t k) const {
@@ -35,6 +36,13 @@ struct SampledGrid {
   }
   [[nodiscard]] bool is_padding(std::size_t i, std::size_t j, std::size_t k) const {
     return i == 0 || j == 0 || k == 0 || i + 1 == padded[0] || j + 1 == padded[1] || k + 1 == padded[2];
+  }
+  [[nodiscard]] bool is_padding_at(std::size_t p) const {
+    return is_padding(p % padded[0], p / padded[0] % padded[1], p / (padded[0] * padded[1]));
+  }
+  /// A sample (not padding) whose level is exactly 0 (not NaN): outside, on the isosurface.
+  [[nodiscard]] bool on_isosurface(std::size_t p) const {
+    return level[p] == 0.0f && !std::signbit(level[p]) && !is_padding_at(p);
   }
   /// Bit c set when corner c (offset (c&1, c>>1&1, c>>2&1)) of cell (i, j, k) is inside.
   [[nodiscard]] std::uint8_t cell_mask(std::size_t i, std::size_t j, std::size_t k) const { return cell_mask_at(index(i, j, k)); }
@@ -55,16 +63,19 @@ struct RepairCounts {
   std::size_t simple = 0;     ///< of those, simple points (no change of topology)
   std::size_t relocated = 0;  ///< of those, flips moving one-sample cavities (two per move; topology kept)
   std::size_t forced = 0;     ///< of those, edits that may change the topology
+  std::size_t degenerate = 0;             ///< of the filled, points of zero-volume cavities
+  std::size_t degenerate_components = 0;  ///< zero-volume cavities filled
   struct Edit {
     std::size_t point;  ///< padded index
     RepairKind kind;
   };
-  std::vector<Edit> edits;  ///< every flip, in the order made (forced ones last)
+  std::vector<Edit> edits;  ///< every flip, in the order made (degenerate ones first, forced ones last)
   std::size_t rounds = 0;
 };
 
 /// Makes the grid manifold, keeping the topology marching cubes gives the samples wherever it
-/// can:
+/// can. First (fill_degenerate_cavities) it fills the zero-volume cavities, which are not part
+/// of the solid's topology; then:
 ///  1. short sequences of simple flips (is_simple_6_18): for each non-manifold cell, the
 ///     shortest sequence of up to 5 simple flips, the first a corner of the cell and each next
 ///     one a corner of a non-manifold cell beside the flip before, that lowers the number of
@@ -93,6 +104,16 @@ struct RepairCounts {
 /// are taken in grid order and the searches are sequential, so the result is the same for
 /// any thread count.
 RepairCounts repair_manifold(SampledGrid& g);
+
+/// Fills the cavities of zero volume: the parts of the outside points under marching cubes'
+/// adjacency for them (18: across faces and face diagonals) that are enclosed by inside points
+/// (no padding), whose every sample has L == 0 exactly (a sample of an integer scan equal to
+/// the isovalue), and that contain no whole cell. Their isosurface {L = 0} is then a point,
+/// segments or doubly covered squares, never a surface around a volume: dual contouring would
+/// put every dual vertex around them onto it (a closed boundary of collapsed quads, degenerate
+/// hexes). Islands, the mirror case, cannot occur: inside points have L > 0. Sequential, in
+/// grid order. Adds the fills to `counts` (kind degenerate) and returns the cavities filled.
+std::size_t fill_degenerate_cavities(SampledGrid& g, RepairCounts& counts);
 
 /// Labels the face-connected parts of the inside points (which are the connected parts of
 /// the hex mesh) and removes those with fewer than `min_points` points. Returns the numbers

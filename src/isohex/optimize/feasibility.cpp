@@ -128,12 +128,22 @@ std::size_t max_min_sweep(HexMesh& mesh, const VertexColoring& coloring, const I
         // later stages are not, and a long jump would trade shape for a tiny gain.
         const MaxMin r = max_min_affine(f, std::vector<double>(f.size(), 1.0), 0.5 * mean_edge_at(mesh, inc, v));
         if (!r.ok || !(r.s > now + 1e-12)) continue;
+        // The hexes around v that are valid now must stay so: with a frame that cannot become
+        // positive (a hex stuck inverted), the max–min place would pull valid frames down to
+        // its negative level, trading one inverted hex for several.
+        std::vector<std::uint8_t> valid_before;
+        for (Index j = inc.offsets[v]; j < inc.offsets[v + 1]; ++j)
+          valid_before.push_back(hex_feasible(mesh.corners(inc.ids[j]), inv_len[inc.ids[j]]));
         const Vec3 old = mesh.points[v];
         mesh.points[v] = old + r.d;
         // Re-evaluated rather than trusted: rounding must not turn the move into a loss.
         double after = 1e300;
         for (const Affine& a : vertex_frames(mesh, inc, inv_len, v, nullptr, skip)) after = std::min(after, a.b);
-        if (after > now) moved[i] = 1;
+        bool keeps_valid = true;
+        for (Index j = inc.offsets[v]; j < inc.offsets[v + 1]; ++j)
+          if (valid_before[j - inc.offsets[v]] && !hex_feasible(mesh.corners(inc.ids[j]), inv_len[inc.ids[j]]))
+            keeps_valid = false;
+        if (after > now && keeps_valid) moved[i] = 1;
         else mesh.points[v] = old;
       }
     });

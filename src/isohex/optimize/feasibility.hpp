@@ -44,7 +44,8 @@ std::vector<Affine> vertex_frames(const HexMesh& mesh, const Incidence& inc, con
 
 /// One Gauss–Seidel round of max–min moves: each vertex with active[v] set goes to the place
 /// within half an edge length that maximises the smallest normalised determinant of its
-/// frames (hexes with (*skip)[h] left out), if that raises it. Colours in order, a colour's
+/// frames (hexes with (*skip)[h] left out), if that raises it and every hex around v that is
+/// valid (all 9 determinants > kMinFeasibleDet) stays valid. Colours in order, a colour's
 /// vertices in parallel (they share no hex): the same bits for any thread count. Returns the
 /// number of moves.
 std::size_t max_min_sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc,

@@ -77,9 +77,9 @@ Scalar shape_term(double F, double D) {
   return r;
 }
 
-Scalar term(const Mat3& A, int t, const EnergyParams& params) {
+Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
   const double F = A.squaredNorm(), D = A.determinant();
-  if (params.untangle) return untangle_term(F, D, params.eps, params.lambda);
+  if (params.untangle) return untangle_term(F, D, eps, params.lambda);
   if (t == kCentreFrame) {  // the centre frame only constrains (validity), it is not optimised
     Scalar r;
     if (!(D > kMinFeasibleDet)) r.f = kInf;
@@ -118,9 +118,10 @@ Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   return A;
 }
 
-double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params) {
+double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps) {
+  if (eps < 0) eps = params.eps;
   double e = 0;
-  for (int t = 0; t < kFrames; ++t) e += term(frame(p, t, inv_len), t, params).f;
+  for (int t = 0; t < kFrames; ++t) e += term(frame(p, t, inv_len), t, params, eps).f;
   return e;
 }
 
@@ -143,11 +144,12 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     while (mesh.hexes[h][k] != v) ++k;
     p[k] = x;
     const double il = inv_len[h];
+    const double eps = params.eps_of(h);
     for (int t = 0; t < kFrames; ++t) {
       const Vec3& c = kCoef[t][k];
       if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
       const Mat3 A = frame(p, t, il);
-      const Scalar s = term(A, t, params);
+      const Scalar s = term(A, t, params, eps);
       e += s.f;
       if (!std::isfinite(e)) return kInf;
       if (!g) continue;
@@ -217,7 +219,7 @@ double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, con
   std::vector<double> e(mesh.hexes.size(), 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h)
-      if (skip.empty() || !skip[h]) e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), inv_len[h], params);
+      if (skip.empty() || !skip[h]) e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), inv_len[h], params, params.eps_of(static_cast<Index>(h)));
   });
   double sum = 0;
   for (double x : e) sum += x;  // in hex order: the same bits for any thread count

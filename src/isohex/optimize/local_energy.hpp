@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <vector>
 
@@ -40,6 +41,12 @@ struct EnergyParams {
   /// Boundary vertices that slide (may be null): their steps are made tangential and put back
   /// on this surface.
   const BoundarySurface* surface = nullptr;
+  /// untangle: per-hex floors of ε (may be null): hex h uses max(eps, (*hex_eps)[h]). The
+  /// untangler freezes ε for hexes that have stopped improving, so that their frames (which
+  /// would grow like 1/ε) cannot dominate the energy of the vertices they share with others.
+  const std::vector<double>* hex_eps = nullptr;
+  /// ε of hex h under these parameters.
+  double eps_of(Index h) const { return hex_eps ? std::max(eps, (*hex_eps)[static_cast<std::size_t>(h)]) : eps; }
 };
 
 /// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
@@ -51,8 +58,9 @@ Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len);
 /// The coefficient c_{t,k} of corner k in frame t (zero when frame t does not use corner k).
 const Vec3& frame_coefficient(int t, int k);
 
-/// The energy of one hex under `params` (+inf if infeasible for the shape stage).
-double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params);
+/// The energy of one hex under `params` (+inf if infeasible for the shape stage), the untangling
+/// energy with regularisation `eps` (params.eps when negative).
+double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps = -1);
 
 /// True when all 9 frames of the hex have determinant > kMinFeasibleDet.
 bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len);

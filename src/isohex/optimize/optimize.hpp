@@ -24,8 +24,12 @@
 ///   that is invalid by rounding (the failure observed with Mesquite on pave1 and ECR bust).
 ///   Hexes that the fixed vertices make impossible are proven so first (find_infeasible(): an
 ///   inverted frame of fixed vertices, or an LP showing that a free vertex has no place) and
-///   given up; when the barrier stalls, max–min LP moves (each vertex to the place that
-///   maximises its smallest frame determinant) try to open the knot.
+///   given up. Hexes that stay inverted while ε falls (no proof, e.g. several free vertices
+///   squeezed between folded boundary sheets) are *stuck*: their ε is frozen so that their
+///   frames cannot dominate the energy of the rest. When neither the inverted count nor the
+///   smallest determinant improves for a number of iterations (a stall), max–min LP moves (each
+///   vertex to the place that maximises its smallest frame determinant, keeping valid hexes
+///   valid) try to open the knot, and if they gain nothing the untangler stops.
 /// - optimize_shape(): Knupp's inverse mean ratio |A|²/(3 det(A)^{2/3}) summed over the 8
 ///   corner frames of each valid hex (ideal: the unit cube corner). A move must keep all 9
 ///   determinants of every incident hex positive, so no valid hex is ever inverted, and it
@@ -79,9 +83,27 @@ using ProgressCallback = std::function<void(const IterationReport&)>;
 struct UntangleOptions {
   double margin = 0.05;   ///< stop once the minimum scaled Jacobian reaches this
   int max_iter = 200;     ///< outer iterations (ε updates)
-  int sweeps = 4;         ///< Gauss–Seidel sweeps per outer iteration
+  int sweeps = 1;         ///< Gauss–Seidel sweeps per outer iteration (each vertex: two Newton steps)
   double lambda = 0.5;    ///< weight of the volume term (D² + 1)/χ
   int rings = 3;          ///< move only vertices within this many hex-rings of hexes below the margin
+  /// Lowest relative decrease σ assumed by the ε schedule (ε's worst-frame χ shrinks by 1 − σ
+  /// per iteration).
+  double min_decrease = 0.5;
+  /// A hex inverted whose smallest frame determinant has not risen by 1e-3 for this many
+  /// iterations is *stuck*: its ε is frozen and it leaves the ε schedule (released if it
+  /// becomes valid).
+  int stuck_after = 5;
+  /// ... counted only while ε is below the inverted depth |D| or below this.
+  double stuck_eps = 1e-3;
+  /// A hex still inverted when ε has fallen below this fraction of its depth |D| is stuck at once
+  /// (the energy has pressed on it ~1/stuck_depth² times harder than at ε = |D| in vain).
+  double stuck_depth = 0.01;
+  /// Stop (after `rescues` max–min LP rescues that gained something) when neither the number of
+  /// inverted hexes nor the smallest determinant of the hexes not stuck improved for this many
+  /// iterations.
+  int stall = 10;
+  double stall_fraction = 0.05;  ///< ... (fewer inverted: by this fraction of them, at least 1)
+  int rescues = 5;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };
@@ -119,6 +141,13 @@ struct UntangleResult {
   /// valid place). Only these hexes may stay inverted because of the fixed vertices.
   std::vector<InfeasibleSet> infeasible;
   std::vector<Index> given_up;     ///< ascending
+  /// Hexes (not given up) that stopped improving while inverted, had their ε frozen, and are
+  /// still inverted at the end (ascending).
+  std::vector<Index> stuck;
+  /// Why it stopped: "margin" (reached), "stall" (no progress for UntangleOptions::stall
+  /// iterations and no LP rescue left that gains), or "max_iter".
+  std::string stop;
+  bool stalled = false;            ///< stop == "stall"
 };
 
 /// Untangles `mesh` in place, vertices with fixed[v] != 0 untouched, every hex except the
@@ -169,5 +198,24 @@ struct WorstResult {
 
 /// Raises the lowest scaled Jacobians in place; the mesh minimum never decreases.
 WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const WorstOptions& options = {});
+
+/// The whole sequence `isohex smooth` and `isohex mesh` run: untangle (optional), shape, worst
+/// pass (optional), with one fixed-vertex mask. One function, so both commands behave the same.
+struct OptimizeOptions {
+  bool untangle = true;
+  bool worst = true;
+  UntangleOptions untangle_options;
+  ShapeOptions shape_options;
+  WorstOptions worst_options;
+};
+struct OptimizeResult {
+  bool untangled = false;  ///< the untangler ran
+  UntangleResult untangle;
+  ShapeResult shape;
+  bool worst_run = false;  ///< the worst-element pass ran
+  WorstResult worst;
+  double untangle_seconds = 0, shape_seconds = 0, worst_seconds = 0;
+};
+OptimizeResult optimize_mesh(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options = {});
 
 }  // namespace isohex

@@ -6,7 +6,7 @@
 #include "isohex/quality/hex_quality.hpp"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,28 +15,25 @@ namespace isohex {
 
 namespace {
 
-// The smallest normalised frame determinant of the hexes not skipped (min is exact: thread-count
-// independent).
-double min_det(const HexMesh& mesh, const std::vector<double>& inv_len, const std::vector<std::uint8_t>* skip) {
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), 1e300,
-      [&](const auto& r, double lo) {
-        for (std::size_t h = r.begin(); h != r.end(); ++h) {
-          if (skip && (*skip)[h]) continue;
-          const auto p = mesh.corners(static_cast<Index>(h));
-          for (int t = 0; t < opt::kFrames; ++t) lo = std::min(lo, opt::frame(p, t, inv_len[h]).determinant());
-        }
-        return lo;
-      },
-      [](double a, double b) { return std::min(a, b); });
+// The smallest normalised frame determinant of each hex (+1e300 for skipped hexes).
+std::vector<double> hex_min_det(const HexMesh& mesh, const std::vector<double>& inv_len,
+                                const std::vector<std::uint8_t>* skip) {
+  std::vector<double> d(mesh.hexes.size(), 1e300);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h) {
+      if (skip && (*skip)[h]) continue;
+      const auto p = mesh.corners(static_cast<Index>(h));
+      for (int t = 0; t < opt::kFrames; ++t) d[h] = std::min(d[h], opt::frame(p, t, inv_len[h]).determinant());
+    }
+  });
+  return d;
 }
 
 // The vertices within `rings` hex-rings of the hexes below the margin: the only ones the
 // untangler moves. Far-away vertices sit near their energy minimum already; sweeping them
 // would cost most of the time on a large mesh with a few tangled spots.
-std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& inc, double margin, int rings,
-                                         const std::vector<std::uint8_t>* skip) {
-  const std::vector<double> sj = scaled_jacobians(mesh);
+std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& sj,
+                                         double margin, int rings, const std::vector<std::uint8_t>* skip) {
   std::vector<std::uint8_t> active(mesh.points.size(), 0);
   for (Index h = 0; h < mesh.num_hexes(); ++h)
     if ((!skip || !(*skip)[h]) && (sj[h] < margin || is_degenerate(sj[h])))
@@ -51,6 +48,19 @@ std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& i
   }
   for (std::uint8_t& a : active) a = !a;
   return active;
+}
+
+// opt::sj_stats from scaled Jacobians already computed.
+opt::SJStats stats_of(const std::vector<double>& sj, const std::vector<std::uint8_t>* skip) {
+  opt::SJStats s;
+  s.min = 1.0;
+  for (std::size_t h = 0; h < sj.size(); ++h) {
+    if (skip && (*skip)[h]) continue;
+    const double v = is_degenerate(sj[h]) ? -1 : sj[h];
+    s.min = std::min(s.min, v);
+    s.inverted += v <= 0;
+  }
+  return s;
 }
 
 double chi(double D, double eps) {
@@ -99,38 +109,55 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     if (skip[h]) res.given_up.push_back(h);
   const std::vector<std::uint8_t>* skipped = res.given_up.empty() ? nullptr : &skip;
   int iterations = 0;
+  std::vector<double> hex_eps(mesh.hexes.size(), 0.0);  // > 0: the hex is stuck, its ε frozen
   const auto finish = [&](const opt::SJStats& s) {
     res.min_sj = s.min;
     res.iterations = iterations;
     res.inverted = skipped ? opt::sj_stats(mesh).inverted : s.inverted;
+    const std::vector<double> sj = scaled_jacobians(mesh);
+    for (Index h = 0; h < mesh.num_hexes(); ++h)
+      if (hex_eps[h] > 0 && (sj[h] <= 0 || is_degenerate(sj[h]))) res.stuck.push_back(h);
     return res;
   };
 
-  opt::SJStats stats = opt::sj_stats(mesh, skipped);
+  std::vector<double> sj = scaled_jacobians(mesh);
+  opt::SJStats stats = stats_of(sj, skipped);
   if (stats.min >= options.margin) {
     res.reached_margin = true;
+    res.stop = "margin";
     return finish(stats);
   }
 
   const Incidence inc = vertex_hexes(mesh);
   const VertexColoring coloring = color_vertices(mesh, fixed);
   const std::vector<double> inv_len = opt::inverse_edge_lengths(mesh);
-  opt::EnergyParams params{true, 1.0, options.lambda, skipped, options.surface};
+  opt::EnergyParams params{true, 1.0, options.lambda, skipped, options.surface, &hex_eps};
   const std::vector<std::uint8_t> no_skip;
   const std::vector<std::uint8_t>& energy_skip = skipped ? skip : no_skip;
-  double best_min = stats.min;
-  int since_best = 0, rescues = 0;
+  // Per hex: the best (highest) smallest frame determinant seen while inverted, and when.
+  std::vector<double> hex_best(mesh.hexes.size(), -1e300);
+  std::vector<int> hex_gain(mesh.hexes.size(), 0);
+  // Progress of the whole: fewest inverted hexes, highest smallest determinant of the hexes
+  // that are neither given up nor stuck.
+  std::size_t best_inverted = stats.inverted;
+  double best_dmin = -1e300;
+  // best_inverted and best_dmin before the first iteration and after each one.
+  std::vector<std::size_t> hist_inverted{best_inverted};
+  std::vector<double> hist_dmin{best_dmin};
+  int since_progress = 0, rescues = 0;
   // The best state seen (fewest inverted hexes, then highest minimum): the energy is global,
   // so an iteration can trade the worst hex for the rest; a failed run must not end worse
   // than it could have.
   std::vector<Vec3> best_points = mesh.points;
   opt::SJStats best = stats;
+  res.stop = "max_iter";
   for (int it = 1; it <= options.max_iter; ++it) {
     const double e_before = opt::total_energy(mesh, inv_len, params, energy_skip);
-    const std::vector<std::uint8_t> frozen = frozen_outside(mesh, inc, options.margin, options.rings, skipped);
+    const std::vector<std::uint8_t> frozen = frozen_outside(mesh, inc, sj, options.margin, options.rings, skipped);
     for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2);
     const double e_after = opt::total_energy(mesh, inv_len, params, energy_skip);
-    stats = opt::sj_stats(mesh, skipped);
+    sj = scaled_jacobians(mesh);
+    stats = stats_of(sj, skipped);
     iterations = it;
     if (options.progress) options.progress({"untangle", it, e_after / (9.0 * mesh.num_hexes()), stats.min, stats.inverted});
     if (stats.inverted < best.inverted || (stats.inverted == best.inverted && stats.min > best.min)) {
@@ -139,40 +166,83 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     }
     if (stats.min >= options.margin) {
       res.reached_margin = true;
+      res.stop = "margin";
       break;
     }
-    // No progress on the worst element for a while: with nothing inverted the margin is out
-    // of reach with these fixed vertices (the shape stages take over from a valid mesh);
-    // otherwise max–min LP moves try to open the knot, and if they cannot, stop.
-    if (stats.min > best_min) {
-      best_min = stats.min;
-      since_best = 0;
-    } else if (++since_best >= (stats.inverted == 0 ? 15 : 20)) {
-      if (stats.inverted == 0 || rescues >= 5) break;
-      ++rescues;
-      // Restart from the best state: the rescue should work on the fewest inverted hexes.
-      mesh.points = best_points;
-      const std::size_t moves = lp_rescue(mesh, coloring, inc, inv_len, skipped, options.surface);
-      res.lp_moves += moves;
-      const opt::SJStats after = opt::sj_stats(mesh, skipped);
-      if (options.progress) options.progress({"lp", rescues, static_cast<double>(moves), after.min, after.inverted});
-      if (after.inverted < best.inverted || (after.inverted == best.inverted && after.min > best.min)) {
+    // Stuck hexes: inverted, and either ε < stuck_depth·|D| (D: their smallest determinant) or
+    // D has not risen by 1e-3 for `stuck_after` iterations while ε < max(|D|, stuck_eps).
+    // Their ε is frozen where it is: lowering it further would make their frames (~|D|/ε² for
+    // D < 0) dominate every vertex they share, crushing the valid neighbours for nothing, and
+    // blow the energy up; they also leave the ε schedule. A stuck hex that becomes valid again
+    // is released.
+    const std::vector<double> hdet = hex_min_det(mesh, inv_len, skipped);
+    double dmin = 1e300;
+    for (Index h = 0; h < mesh.num_hexes(); ++h) {
+      if (skipped && skip[h]) continue;
+      if (hdet[h] > 0) {
+        hex_eps[h] = 0;
+        hex_best[h] = -1e300;
+      } else if (hex_eps[h] == 0 && params.eps < options.stuck_depth * -hdet[h]) {
+        hex_eps[h] = params.eps;  // pressed hard (ε far below its depth) and still inverted
+      } else if (hdet[h] > hex_best[h] + 1e-3 || params.eps > std::max(-hdet[h], options.stuck_eps)) {
+        // Improving, or ε still above the depth of the inversion and `stuck_eps` (the energy
+        // has not pressed on it hard yet): not stuck.
+        hex_best[h] = hdet[h];
+        hex_gain[h] = it;
+      } else if (hex_eps[h] == 0 && it - hex_gain[h] >= options.stuck_after) {
+        hex_eps[h] = params.eps;
+      }
+      if (hex_eps[h] == 0) dmin = std::min(dmin, hdet[h]);
+    }
+    if (dmin == 1e300) dmin = 1;  // everything left is stuck or given up
+    // Stall: over the last `stall` iterations, the fewest inverted hexes fell by less than
+    // `stall_fraction` (and less than 1) and the smallest determinant of the hexes not stuck
+    // rose by less than 1e-3. With hexes still inverted, max–min LP moves from the best state
+    // try to open the knot first; if they gain nothing, stop.
+    best_inverted = std::min(best_inverted, stats.inverted);
+    best_dmin = std::max(best_dmin, dmin);
+    hist_inverted.push_back(best_inverted);
+    hist_dmin.push_back(best_dmin);
+    ++since_progress;
+    if (since_progress >= options.stall) {
+      // `stall` iterations ago:
+      const std::size_t k = hist_inverted.size() - 1 - static_cast<std::size_t>(options.stall);
+      const double then_inv = static_cast<double>(hist_inverted[k]);
+      const bool fewer = static_cast<double>(best_inverted) <= then_inv - std::max(1.0, options.stall_fraction * then_inv);
+      const bool higher = best_dmin >= hist_dmin[k] + 1e-3;
+      if (!fewer && !higher) {
+        if (stats.inverted == 0 || rescues >= options.rescues) {
+          res.stop = "stall";
+          break;
+        }
+        ++rescues;
+        // From the best state: the rescue should work on the fewest inverted hexes.
+        mesh.points = best_points;
+        const std::size_t moves = lp_rescue(mesh, coloring, inc, inv_len, skipped, options.surface);
+        const opt::SJStats after = opt::sj_stats(mesh, skipped);
+        if (options.progress) options.progress({"lp", rescues, static_cast<double>(moves), after.min, after.inverted});
+        if (!(after.inverted < best.inverted || (after.inverted == best.inverted && after.min > best.min))) {
+          mesh.points = best_points;  // the rescue gained nothing
+          res.stop = "stall";
+          break;
+        }
+        res.lp_moves += moves;
         best = after;
         best_points = mesh.points;
+        stats = after;
+        best_inverted = std::min(best_inverted, after.inverted);
+        sj = scaled_jacobians(mesh);
+        since_progress = 0;  // a new window from here
       }
-      if (moves == 0) break;
-      stats = after;
-      best_min = std::max(best_min, after.min);
-      since_best = 0;
     }
     // ε update: the energy's relative decrease σ sets how far ε may drop; ε is chosen so
-    // that the worst frame's χ shrinks by (1 − σ), which keeps it finite and the energy smooth.
-    const double sigma = std::max(1 - e_after / e_before, 0.1);
-    const double dmin = min_det(mesh, inv_len, skipped);
+    // that the worst frame's χ (over the hexes neither given up nor stuck) shrinks by (1 − σ).
+    const double sigma = std::max(1 - e_after / e_before, options.min_decrease);
     const double mu = (1 - sigma) * chi(dmin, params.eps);
     params.eps = dmin < mu ? 2 * std::sqrt(mu * (mu - dmin)) : params.eps * (1 - sigma);
     params.eps = std::max(params.eps, 1e-12);
   }
+  res.stalled = res.stop == "stall";
   if (!res.reached_margin) {
     mesh.points.swap(best_points);
     stats = best;

@@ -98,9 +98,16 @@ std::size_t pin_outside_grid(const HexMesh& mesh, const std::vector<std::uint8_t
   return n;
 }
 
-SurfaceQuality quality_of(const HexMesh& mesh, const std::vector<Quad>& quads) {
+SurfaceQuality quality_of(const HexMesh& mesh, const surface_detail::SurfaceGraph& graph) {
   SurfaceQuality q;
-  const QuadSummary qs = summarize_quads(mesh, quads);
+  const QuadSummary qs = summarize_quads(mesh, graph.quads);
+  q.fan_margin_min = 1;
+  for (Index b = 0; b < mesh.num_vertices(); ++b) {
+    if (!graph.on_boundary[b]) continue;
+    const double m = surface_detail::fan_margin(mesh, graph, b, b, mesh.points[b]);
+    q.fan_margin_min = std::min(q.fan_margin_min, m);
+    q.fans_below += m < kQuestionableSJ;
+  }
   q.num_quads = qs.count;
   q.quad_sj_min = qs.min;
   q.quad_sj_mean = qs.mean;
@@ -130,9 +137,9 @@ double quad_sj_of(const HexMesh& mesh, const Quad& q) {
   return quad_scaled_jacobian({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
 }
 
-// Passes of max–min moves over the free boundary vertices of quads below the target, in
-// colour classes (no two vertices of a class share a quad), until a pass moves nothing.
-// Pinned vertices keep their place but their normals still orient their quads.
+// Passes of max–min moves over the free boundary vertices of quads below the target (or
+// turned over), in classes none of whose members reads another's position (the score of v
+// reads the fans of its neighbours), until a pass moves nothing.
 void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding,
                        const std::vector<std::uint8_t>& on_isosurface, const SurfaceSmoothingOptions& options,
                        SurfaceSmoothingReport& report) {
@@ -154,10 +161,11 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
     if (work.empty()) break;
     report.worst_passes = pass + 1;
     std::size_t moved = 0;
-    for (const auto& cls : surface_detail::colour_classes(work, mesh, ctx.graph.vertex_hexes)) {
+    for (const auto& cls : surface_detail::read_disjoint_classes(work, ctx.graph)) {
       tbb::parallel_for(std::size_t{0}, cls.size(), [&](std::size_t i) {
         outcome[cls[i]] =
-            surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius, options.worst_levels, turned);
+            surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius, options.worst_levels, turned,
+                                             options.worst_target);
       });
       for (Index v : cls) moved += outcome[v] == MoveOutcome::accepted;
     }
@@ -168,7 +176,9 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
 
 }  // namespace
 
-SurfaceQuality surface_quality(const HexMesh& mesh) { return quality_of(mesh, boundary_quads(mesh)); }
+SurfaceQuality surface_quality(const HexMesh& mesh) {
+  return quality_of(mesh, surface_detail::build_surface_graph(mesh, 0.5));
+}
 
 namespace {
 
@@ -244,7 +254,7 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
 
   SurfaceSmoothingReport report;
   report.outside_grid = outside_grid;
-  report.before = quality_of(mesh, graph.quads);
+  report.before = quality_of(mesh, graph);
 
   // Free boundary vertices: sliding ones and crease ones (projection only).
   std::vector<Index> boundary;
@@ -295,7 +305,7 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
   // Onto the isosurface first: the relaxation's guarantees start from the projected mesh.
   sweep(boundary_classes, outcome, report,
         [&](Index v) { return surface_detail::move_boundary_vertex(ctx, v, Vec3::Zero()); });
-  report.projected = quality_of(mesh, graph.quads);
+  report.projected = quality_of(mesh, graph);
   ctx.quad_hard_floor = report.projected.quad_sj_min;
 
   for (int it = 0; it < options.iterations; ++it) {
@@ -346,7 +356,7 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
   }
   report.max_level_relative = report.max_level / field.value_range();
   for (Index v = 0; v < nv; ++v) report.max_displacement = std::max(report.max_displacement, (mesh.points[v] - start[v]).norm());
-  report.after = quality_of(mesh, graph.quads);
+  report.after = quality_of(mesh, graph);
   return report;
 }
 

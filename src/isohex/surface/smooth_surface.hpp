@@ -105,6 +105,11 @@ struct SurfaceQuality {
   double quad_sj_mean = 0;         ///< mean boundary-quad scaled Jacobian
   std::size_t quads_below = 0;     ///< boundary quads with scaled Jacobian < 0.2 (kQuestionableSJ)
   std::size_t num_quads = 0;       ///< boundary quads
+  /// Smallest *fan margin* of a boundary vertex: how well one direction can point into all
+  /// the quad corners around it (see docs/surface-smoothing.md). A boundary hex (or pillow
+  /// hex) corner there cannot have a scaled Jacobian above it.
+  double fan_margin_min = 0;
+  std::size_t fans_below = 0;      ///< boundary vertices with fan margin < 0.2 (kQuestionableSJ)
   double hex_sj_min = 0;           ///< smallest hex scaled Jacobian (degenerate hexes excluded)
   std::size_t hexes_inverted = 0;  ///< hexes with scaled Jacobian < 0
   std::size_t hexes_degenerate = 0;///< hexes with Verdict's degenerate marker

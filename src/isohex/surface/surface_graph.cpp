@@ -1,6 +1,8 @@
 #include "isohex/surface/surface_graph.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <unordered_map>
 #include <array>
 #include <tuple>
 
@@ -120,6 +122,40 @@ std::vector<std::vector<Index>> colour_classes(const std::vector<Index>& vertice
     for (Index k = vertex_hexes.offsets[v]; k < vertex_hexes.offsets[v + 1]; ++k)
       for (Index w : mesh.hexes[vertex_hexes.ids[k]])
         if (colour[w] >= 0) used[static_cast<std::size_t>(colour[w])] = 1;
+    const auto c = static_cast<std::size_t>(std::find(used.begin(), used.end(), 0) - used.begin());
+    if (c == classes.size()) classes.emplace_back();
+    classes[c].push_back(v);
+    colour[v] = static_cast<int>(c);
+  }
+  return classes;
+}
+
+std::vector<std::vector<Index>> read_disjoint_classes(const std::vector<Index>& vertices, const SurfaceGraph& graph) {
+  const auto reads = [&](Index v, auto&& f) {
+    const auto each_quad_vertex = [&](Index w) {
+      for (Index k = graph.vertex_quads.offsets[w]; k < graph.vertex_quads.offsets[w + 1]; ++k)
+        for (Index x : graph.quads[graph.vertex_quads.ids[k]]) f(x);
+    };
+    each_quad_vertex(v);
+    for (Index k = graph.boundary_neighbours.offsets[v]; k < graph.boundary_neighbours.offsets[v + 1]; ++k)
+      each_quad_vertex(graph.boundary_neighbours.ids[k]);
+  };
+  // Who reads whom, both ways: (reader, read) pairs sorted by the read vertex.
+  std::vector<std::array<Index, 2>> pairs;
+  for (Index v : vertices) reads(v, [&](Index x) { pairs.push_back({x, v}); });
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  std::unordered_map<Index, int> colour;
+  std::vector<std::vector<Index>> classes;
+  std::vector<char> used;
+  for (Index v : vertices) {
+    used.assign(classes.size() + 1, 0);
+    const auto mark = [&](Index x) {
+      if (const auto it = colour.find(x); it != colour.end()) used[static_cast<std::size_t>(it->second)] = 1;
+    };
+    reads(v, mark);  // those v reads
+    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::array<Index, 2>{v, std::numeric_limits<Index>::min()});
+    for (; it != pairs.end() && (*it)[0] == v; ++it) mark((*it)[1]);  // those that read v
     const auto c = static_cast<std::size_t>(std::find(used.begin(), used.end(), 0) - used.begin());
     if (c == classes.size()) classes.emplace_back();
     classes[c].push_back(v);

@@ -44,4 +44,9 @@ std::vector<Index> interior_band(const HexMesh& mesh, const SurfaceGraph& graph,
 std::vector<std::vector<Index>> colour_classes(const std::vector<Index>& vertices, const HexMesh& mesh,
                                                const Incidence& vertex_hexes);
 
+/// Splits boundary vertices `vertices` into classes such that no member of a class reads
+/// another: v reads the vertices of the boundary quads around v and around its boundary
+/// neighbours (what the max–min pass's score of v looks at). Greedy, in the given order.
+std::vector<std::vector<Index>> read_disjoint_classes(const std::vector<Index>& vertices, const SurfaceGraph& graph);
+
 }  // namespace isohex::surface_detail

@@ -115,15 +115,28 @@ double oriented_quad_sj(const std::array<Vec3, 4>& c, const Vec3& reference);
 /// One local max–min move of boundary vertex `v` on its surface (worst_moves.cpp): a compass
 /// search in the tangent plane (normal outward_normal()), 8 directions at steps of `radius`
 /// × the vertex's mean boundary edge, halved up to `levels` times; each trial point is put
-/// back on the surface by constrain(). Scores a trial by the smallest scaled Jacobian of the
-/// boundary quads around `v`, ties broken by their sum; a quad that would turn over from
-/// where it is now scores kFlippedQuad, and so does one with a nonzero `turned[q]` (one that
-/// has turned over: turned_over_quads()) until it faces that reference. Takes the best trial
-/// at the coarsest step that improves the score, so the minimum around `v` never decreases.
+/// back on the surface by constrain(). Scores a trial by the scaled Jacobians of the boundary
+/// quads around `v` and the fan_margin() of `v` and of its boundary neighbours, compared
+/// leximin (the smallest first, then the next, ...); a quad that would turn over from where it
+/// is now scores kFlippedQuad, and so does one with a nonzero `turned[q]` (one that has turned
+/// over: turned_over_quads()) until it faces that reference. Takes the best trial at the
+/// coarsest step that improves the score, so the smallest of those values never decreases.
+/// Values above `cap` count as `cap`: good enough, and free to trade for the worse ones.
 /// With `guard_hexes` the hexes around `v` must keep their floors as in
 /// move_is_acceptable(). Returns dropped when no trial improves.
 MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int levels,
-                             const std::vector<Vec3>& turned);
+                             const std::vector<Vec3>& turned, double cap);
+
+/// How well one direction can point out of every quad corner at boundary vertex `b` (with
+/// vertex `v` moved to `y`): the largest, over unit directions d, of the smallest c·d over the
+/// boundary quads at `b`, c being the corner's two edges' cross product over their lengths
+/// (outward; its length is the sine of the corner angle, so a flat regular fan of 4 scores
+/// 1). A pillow hex on each of those quads has its edge at `b` along −d: a fan with no
+/// positive margin leaves one of them inverted whatever the optimiser does. Approximated by
+/// the best of the corners' own directions, their pairwise bisectors and their sum.
+double fan_margin(const MoveContext& ctx, Index b, Index v, const Vec3& y);
+/// The same on any mesh and its graph.
+double fan_margin(const HexMesh& mesh, const SurfaceGraph& graph, Index b, Index v, const Vec3& y);
 
 /// Per boundary quad, zero, or for a quad that faces inward an outward reference direction:
 /// a quad faces inward when its normal points against both the isosurface's outward normals

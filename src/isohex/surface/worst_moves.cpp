@@ -5,6 +5,7 @@
 #include "isohex/surface/vertex_moves.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -20,19 +21,80 @@ std::array<Vec3, 4> quad_corners(const HexMesh& mesh, const Quad& q, Index v, co
   return c;
 }
 
-// The smallest and the sum of the oriented_quad_sj() of the boundary quads around v, with v
-// at y. Compared lexicographically: the sum breaks ties of the minimum, e.g. where three
-// vertices sit on one point and moving one of them leaves the minimum at 0.
+// The values a move of v changes, sorted ascending and compared *leximin*: the smallest
+// decides, then the next, and so on. Where the smallest cannot change (three vertices on one
+// point, a fan held by a pinned vertex) the next ones still may rise, and none may fall.
 struct Score {
-  double min = 1, sum = 0;
+  static constexpr int kMax = 48;
+  std::array<double, kMax> v{};
+  int n = 0;
+  double cap = 1;  // values above it count as it: good enough, free to trade
+  void add(double x) {
+    if (n < kMax) v[static_cast<std::size_t>(n++)] = std::min(x, cap);
+  }
+  void finish() { std::sort(v.begin(), v.begin() + n); }
+  [[nodiscard]] double min() const { return n > 0 ? v[0] : 1.0; }
   [[nodiscard]] bool beats(const Score& o) const {
-    return min > o.min + 1e-12 || (min >= o.min && sum > o.sum + 1e-9);
+    for (int i = 0; i < std::min(n, o.n); ++i) {
+      if (v[static_cast<std::size_t>(i)] > o.v[static_cast<std::size_t>(i)] + 1e-12) return true;
+      if (v[static_cast<std::size_t>(i)] < o.v[static_cast<std::size_t>(i)] - 1e-12) return false;
+    }
+    return false;
   }
 };
 
-Score score_around(const MoveContext& ctx, Index v, const Vec3& y, const std::vector<Vec3>& turned) {
+}  // namespace
+
+// The max over unit d of the min over b's quads of c·d, c the corner's cross product of
+// its two edges divided by their lengths (outward; |c| = sin of the corner angle). The
+// pillow hex on each quad has its edge at b pointing along −d, so a fan with no positive
+// margin leaves some pillow hex inverted whatever the optimiser does. The max is taken over
+// the corners' own directions, their pairwise bisectors and their sum (exact when at most two
+// corners bind, close otherwise).
+double fan_margin(const MoveContext& ctx, Index b, Index v, const Vec3& y) { return fan_margin(ctx.mesh, ctx.graph, b, v, y); }
+
+double fan_margin(const HexMesh& mesh, const SurfaceGraph& graph, Index b, Index v, const Vec3& y) {
+  const auto P = [&](Index w) -> const Vec3& { return w == v ? y : mesh.points[w]; };
+  std::array<Vec3, 16> c;
+  std::array<Vec3, 16> unit;
+  int n = 0;
+  const auto& vq = graph.vertex_quads;
+  for (Index k = vq.offsets[b]; k < vq.offsets[b + 1] && n < 16; ++k) {
+    const Quad& q = graph.quads[vq.ids[k]];
+    int i = 0;
+    while (i < 4 && q[i] != b) ++i;
+    const Vec3 e1 = P(q[(i + 1) % 4]) - P(b), e2 = P(q[(i + 3) % 4]) - P(b);
+    const double l = e1.norm() * e2.norm();
+    if (!(l > 0)) return 0.0;  // a collapsed edge: no direction helps
+    c[n] = e1.cross(e2) / l;
+    const double cl = c[n].norm();
+    unit[n] = cl > 0 ? Vec3(c[n] / cl) : Vec3::Zero();
+    ++n;
+  }
+  if (n == 0) return 1.0;
+  const auto margin = [&](const Vec3& d) {
+    const double l = d.norm();
+    if (!(l > 0)) return -1.0;
+    double m = 1.0;
+    for (int i = 0; i < n; ++i) m = std::min(m, c[i].dot(d) / l);
+    return m;
+  };
+  Vec3 sum = Vec3::Zero();
+  for (int i = 0; i < n; ++i) sum += unit[i];
+  double best = margin(sum);
+  for (int i = 0; i < n; ++i) {
+    best = std::max(best, margin(unit[i]));
+    for (int j = i + 1; j < n; ++j) best = std::max(best, margin(unit[i] + unit[j]));
+  }
+  return best;
+}
+
+namespace {
+
+Score score_around(const MoveContext& ctx, Index v, const Vec3& y, const std::vector<Vec3>& turned, double cap) {
   const auto& vq = ctx.graph.vertex_quads;
   Score s;
+  s.cap = cap;
   for (Index k = vq.offsets[v]; k < vq.offsets[v + 1]; ++k) {
     const Quad& q = ctx.graph.quads[vq.ids[k]];
     // A quad may not turn over from where it is now (a fold-over of a whole quad, which
@@ -42,10 +104,13 @@ Score score_around(const MoveContext& ctx, Index v, const Vec3& y, const std::ve
     const Vec3 now = ref.squaredNorm() > 0 ? ref
                                           : Vec3((ctx.mesh.points[q[2]] - ctx.mesh.points[q[0]])
                                                      .cross(ctx.mesh.points[q[3]] - ctx.mesh.points[q[1]]));
-    const double sj = oriented_quad_sj(quad_corners(ctx.mesh, q, v, y), now);
-    s.min = std::min(s.min, sj);
-    s.sum += sj;
+    s.add(oriented_quad_sj(quad_corners(ctx.mesh, q, v, y), now));
   }
+  // The fans whose corners move with v: its own and its edge neighbours'.
+  s.add(fan_margin(ctx, v, v, y));
+  const auto& nb = ctx.graph.boundary_neighbours;
+  for (Index k = nb.offsets[v]; k < nb.offsets[v + 1]; ++k) s.add(fan_margin(ctx, nb.ids[k], v, y));
+  s.finish();
   return s;
 }
 
@@ -75,9 +140,9 @@ double oriented_quad_sj(const std::array<Vec3, 4>& c, const Vec3& reference) {
 }
 
 MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int levels,
-                             const std::vector<Vec3>& turned) {
+                             const std::vector<Vec3>& turned, double cap) {
   const Vec3 x = ctx.mesh.points[v];
-  const Score current = score_around(ctx, v, x, turned);
+  const Score current = score_around(ctx, v, x, turned, cap);
   // The tangent plane of the isosurface at v.
   const Vec3 n = outward_normal(ctx, v);
   const Vec3 a = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
@@ -98,7 +163,7 @@ MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int
       const double t = 2 * std::numbers::pi * d / kDirections;
       Vec3 y = x + step * (std::cos(t) * a + std::sin(t) * b);
       if (!constrain(ctx, v, y, 2 * edge)) continue;
-      const Score value = score_around(ctx, v, y, turned);
+      const Score value = score_around(ctx, v, y, turned, cap);
       if (value.beats(best_score) && hexes_allow(ctx, v, y)) {
         best_score = value;
         best = y;
