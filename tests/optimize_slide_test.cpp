@@ -48,10 +48,11 @@ Outcome optimise(const HexMesh& in, bool slide, int threads = 2) {
   ShapeOptions so;
   so.surface = slide ? &surface : nullptr;
   optimize_shape(r.mesh, fixed, so);
+  // The shape stage's objective: the worst pass after it trades the mean for the minimum.
+  r.objective = shape_objective(r.mesh);
   WorstOptions wo;
   wo.surface = so.surface;
   improve_worst(r.mesh, fixed, wo);
-  r.objective = shape_objective(r.mesh);
   r.min_sj = 1;
   for (double q : scaled_jacobians(r.mesh)) {
     r.min_sj = std::min(r.min_sj, is_degenerate(q) ? -1.0 : q);

@@ -183,8 +183,9 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
 /// Options of the worst-element pass.
 struct WorstOptions {
   double below = 1.5;     ///< work on the vertices of hexes with scaled Jacobian below this ...
-  std::size_t count = 100;  ///< ... at most this many of the worst
-  int passes = 10;
+  std::size_t count = 100;  ///< ... at most this many of the worst,
+  double raise_below = 0.3; ///< ... and on those of every hex below this (the questionable ones and a margin)
+  int passes = 30;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };

@@ -97,7 +97,9 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return sj[a] < sj[b]; });
     std::size_t moved = 0;
-    for (std::size_t i = 0; i < order.size() && i < options.count && sj[order[i]] < options.below; ++i) {
+    for (std::size_t i = 0;
+         i < order.size() && ((i < options.count && sj[order[i]] < options.below) || sj[order[i]] < options.raise_below);
+         ++i) {
       for (Index v : mesh.hexes[order[i]]) {
         if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
         seen[v] = pass;
