@@ -4,6 +4,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/summary.hpp"
 
 #include <algorithm>
 #include <numeric>
@@ -20,9 +21,11 @@ double sj_value(const std::array<Vec3, 8>& p) {
 
 // The lowest scaled Jacobian of the hexes around v with v placed at x. With `valid`, also
 // whether every hex that is valid now (scaled Jacobian > 0) stays valid there.
-double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool* valid = nullptr) {
+double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool* valid = nullptr,
+                 int* questionable = nullptr) {
   double lo = 2.0;
   if (valid) *valid = true;
+  if (questionable) *questionable = 0;
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     auto p = mesh.corners(h);
@@ -30,6 +33,7 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
       if (mesh.hexes[h][k] == v) p[k] = x;
     const double q = sj_value(p);
     lo = std::min(lo, q);
+    if (questionable) *questionable += q < kQuestionableSJ;
     if (valid && q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
   }
   return lo;
@@ -39,7 +43,8 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
 // shrinking steps; the first that raises the local minimum (inverting nothing) is taken.
 bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySurface* surface) {
   const Vec3 x0 = mesh.points[v];
-  const double m0 = local_min(mesh, inc, v, x0);
+  int below0 = 0;
+  const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0);
   const double len = opt::mean_edge_at(mesh, inc, v);
   if (!(len > 0)) return false;
   const double h = 1e-5 * len;
@@ -67,10 +72,13 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySur
   for (int i = 0; i < 12; ++i, t *= 0.5) {
     const Vec3 x = slides ? surface->project(x0 + t * d, &n) : Vec3(x0 + t * d);
     bool valid = false;
+    int below = 0;
     // Raising the local minimum is not enough when it is negative: a valid neighbour must
-    // not be inverted on the way (it could still sit above that negative minimum).
-    const double q = local_min(mesh, inc, v, x, &valid);
-    if (valid && q > best) {
+    // not be inverted on the way (it could still sit above that negative minimum). Nor may
+    // more hexes around v fall below 0.2: raising one by bending its neighbours down to it
+    // would trade one questionable hex for several.
+    const double q = local_min(mesh, inc, v, x, &valid, &below);
+    if (valid && below <= below0 && q > best) {
       best = q;
       best_x = x;
     }
