@@ -41,6 +41,14 @@ def cases(data, tmp):
         ("mAChE (iso 1, h 1)", "mAChE", [mache, "--iso", "1", "--cell-size", "1"],
          ["volume", "molecule", os.path.join(data, "molecules", "mache_1MAH.pqr"), "-o", mache]),
         ("MR head (iso 40, h 4)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "4"], None),
+        # The same scans on the smoothing cubic B-spline of their samples (--interpolation
+        # smooth-cubic): the boundary lies on that isosurface instead of the trilinear one.
+        ("cthead (skin, h 4, smooth-cubic)", "head", [v("cthead_256x256x113_int16be.raw"), "--iso", "600", "--cell-size", "4",
+                                               "--interpolation", "smooth-cubic"] + CTHEAD, None),
+        ("headsq (bone, h 3.2, smooth-cubic)", "head", [v("headsq_64x64x93_int16le.raw"), "--iso", "1150", "--cell-size",
+                                                 "3.2", "--interpolation", "smooth-cubic"] + HEADSQ, None),
+        ("MR head (iso 40, h 4, smooth-cubic)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "4",
+                                                "--interpolation", "smooth-cubic"], None),
     ]
 
 
