@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdio>
+#include <cstdlib>
 
 namespace isohex::contour {
 
@@ -576,6 +578,18 @@ RepairCounts repair_manifold(SampledGrid& g) {
         simple_phase(g, counts, Search::deep, cells) == 0)
       break;
     simple_phase(g, counts, Search::short_, cells);
+  }
+  if (const char* dump = std::getenv("ISOHEX_DUMP_BLOCK")) {  // DEBUG-TEMP
+    std::FILE* f = std::fopen(dump, "w");
+    for (std::size_t cell : cells) {
+      const std::size_t ci = cell % g.padded[0], cj = cell / g.padded[0] % g.padded[1], ck = cell / dz;
+      std::fprintf(f, "cell %zu %zu %zu mask %d\n", ci - 1, cj - 1, ck - 1, g.cell_mask_at(cell));
+      for (std::size_t k = ck - 5; k <= ck + 6; ++k)
+        for (std::size_t j = cj - 5; j <= cj + 6; ++j)
+          for (std::size_t i = ci - 5; i <= ci + 6; ++i)
+            std::fprintf(f, "p %zu %zu %zu %d %.9g\n", i - 1, j - 1, k - 1, g.inside[g.index(i, j, k)], g.level[g.index(i, j, k)]);
+    }
+    std::fclose(f);
   }
   const std::size_t simple_carved = counts.carved, simple_filled = counts.filled;
   const std::size_t before_carving = counts.edits.size();
