@@ -19,6 +19,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <ostream>
 #include <unistd.h>
@@ -39,6 +40,7 @@ struct Args {
   std::vector<double> spacing, origin;
   std::size_t header_bytes = 0;
   bool no_surface_smoothing = false, no_pillow = false, no_smooth = false;
+  bool slide = false;  ///< --boundary slide: boundary vertices slide on the isosurface in the optimisation
   int surface_iterations = 30;
   std::optional<double> feature_angle;
   int* threads = nullptr;
@@ -149,6 +151,10 @@ void run(const Args& a) {
     spec.outer = contour::parse_outer(a.outer);
   }
   const contour::Region region = contour::make_region(volume, spec);
+  if (a.slide && (a.no_smooth || region.surfaces.size() != 1 || !region.surfaces[0].field()))
+    throw Error(a.no_smooth ? "--boundary slide acts in the optimisation stage, which --no-smooth skips"
+                            : "--boundary slide needs a region bounded by one isosurface (--region inside, or outside "
+                              "up to the volume's box); use the default --boundary fixed");
 
   contour::ExtractOptions opt;
   opt.cell_size = cell_size > 0 ? cell_size : 0;
@@ -198,7 +204,9 @@ void run(const Args& a) {
   std::size_t inverted_left = 0;
   if (!a.no_smooth) {
     t = Clock::now();
-    optimisation = optimise_stage(out.mesh, terminal, inverted_left);
+    SlideSpec slide;
+    if (a.slide) slide = {region.surfaces[0].field(), &out.vertex_place, 0, feature_angle};
+    optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide);
     rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t)));
     rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
                          {"shape sweeps", optimisation["shape"]["iterations"]},
@@ -345,6 +353,12 @@ void register_mesh(CLI::App& app) {
                 "Skip boundary pillowing (on by default: a sheet of hexes inside the boundary, surface unchanged)");
   cmd->add_flag("--no-smooth", a->no_smooth,
                 "Skip untangling and mean-ratio optimisation (on by default; boundary vertices fixed)");
+  const std::map<std::string, bool> boundary_names{{"fixed", false}, {"slide", true}};
+  cmd->add_option("--boundary", a->slide,
+                  "Boundary vertices in the optimisation: fixed (default) or slide (move on the isosurface, "
+                  "reprojected onto it; crease (--feature-angle) and box-face vertices pinned; one-isosurface "
+                  "regions only)")
+      ->transform(CLI::CheckedTransformer(boundary_names, CLI::ignore_case));
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
   cmd->add_option("--report", a->report,

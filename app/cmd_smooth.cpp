@@ -9,6 +9,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/summary.hpp"
+#include "isohex/volume/volume_io.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -27,6 +28,8 @@ namespace {
 
 struct Args {
   std::string in, out, json;
+  std::string volume, inside = "above";  ///< --boundary slide on the isosurface of a volume
+  std::optional<double> iso;
   bool untangle = false, skip_non_hex = false, no_worst = false, slide = false;
   double feature_angle = 30;
   FixedVertices fixed = FixedVertices::boundary;
@@ -57,16 +60,32 @@ void run(const Args& a) {
   const auto t0 = std::chrono::steady_clock::now();
   if (a.slide && a.fixed != FixedVertices::boundary)
     throw Error("smooth: --boundary slide moves the boundary vertices; it needs --fixed boundary (the default)");
+  if (!a.volume.empty() && !a.slide) throw Error("smooth: --volume is only used with --boundary slide");
+  if (!a.volume.empty() && !a.iso) throw Error("smooth: --volume needs --iso V");
+  if (a.volume.empty() && a.iso) throw Error("smooth: --iso is only used with --volume");
   HexMesh mesh = load_mesh(a.in, a.skip_non_hex);
-  // With --boundary slide the boundary vertices move on the input's own boundary surface,
-  // except those on sharp feature edges (pinned): only those are fixed.
+  // With --boundary slide the boundary vertices move on the input's own boundary surface, or
+  // on the isosurface of --volume, except those on sharp feature edges (and, on an isosurface,
+  // those off it): only those are fixed.
+  std::unique_ptr<Volume> volume;
+  std::unique_ptr<IsoField> field;
   std::unique_ptr<BoundarySurface> surface;
-  if (a.slide) surface = std::make_unique<BoundarySurface>(mesh, a.feature_angle);
+  if (!a.volume.empty()) {
+    volume = std::make_unique<Volume>(read_volume(a.volume));
+    field = std::make_unique<IsoField>(*volume, *a.iso, *inside_from_name(a.inside));
+    surface = std::make_unique<BoundarySurface>(mesh, *field, a.feature_angle);
+  } else if (a.slide) {
+    surface = std::make_unique<BoundarySurface>(mesh, a.feature_angle);
+  }
   const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(mesh, a.fixed);
   std::size_t n_fixed = 0;
   for (std::uint8_t f : fixed) n_fixed += f != 0;
   fmt::print("{}: {} hexes, {} vertices, {} fixed\n", a.in, mesh.num_hexes(), mesh.num_vertices(), n_fixed);
-  if (surface)
+  if (surface && field)
+    fmt::print("boundary: {} vertices slide on the isosurface {} of {}, {} pinned (feature edges > {} degrees, or "
+               "off the isosurface)\n",
+               surface->num_sliding(), *a.iso, a.volume, surface->num_pinned(), a.feature_angle);
+  else if (surface)
     fmt::print("boundary: {} vertices slide on the input's boundary, {} pinned on feature edges (> {} degrees)\n",
                surface->num_sliding(), surface->num_pinned(), a.feature_angle);
   if (a.fixed == FixedVertices::file && !mesh.has_fixed())
@@ -110,15 +129,21 @@ void run(const Args& a) {
   fmt::print("time: {:.2f} s\n", seconds);
   report["after"] = quality_json(after);
   if (surface) {
-    // A self-check in the report: how far the sliding vertices are from the original surface.
+    // A self-check in the report: how far the sliding vertices are from the target surface
+    // (a distance for the input's boundary, |f - iso| / range for an isosurface).
     double far = 0;
     for (Index v = 0; v < mesh.num_vertices(); ++v)
-      if (surface->role(v) == BoundarySurface::Role::slides)
-        far = std::max(far, (surface->project(mesh.points[v]) - mesh.points[v]).norm());
+      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(mesh.points[v]));
     report["boundary"] = {{"mode", "slide"},       {"sliding", surface->num_sliding()},
                           {"pinned", surface->num_pinned()}, {"feature_angle", a.feature_angle},
-                          {"max_distance", far}};
-    fmt::print("boundary: sliding vertices at most {:.3g} from the input's boundary\n", far);
+                          {"target", field ? "isosurface" : "input boundary"}};
+    if (field) {
+      report["boundary"]["max_relative_level"] = far;
+      fmt::print("boundary: sliding vertices at most {:.3g} x range from the isosurface (|f - iso| / range)\n", far);
+    } else {
+      report["boundary"]["max_distance"] = far;
+      fmt::print("boundary: sliding vertices at most {:.3g} from the input's boundary\n", far);
+    }
   }
   report["seconds"] = seconds;
 
@@ -144,9 +169,15 @@ void register_smooth(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(fixed_names, CLI::ignore_case));
   const std::map<std::string, bool> boundary_names{{"fixed", false}, {"slide", true}};
   cmd->add_option("--boundary", a->slide,
-                  "Boundary vertices: fixed (default) or slide (move on the input's boundary surface, "
-                  "feature-edge vertices pinned)")
+                  "Boundary vertices: fixed (default) or slide (move on the input's boundary surface, or on the "
+                  "isosurface of --volume, feature-edge vertices pinned)")
       ->transform(CLI::CheckedTransformer(boundary_names, CLI::ignore_case));
+  cmd->add_option("--volume", a->volume,
+                  "With --boundary slide: slide on the isosurface --iso of this volume (.nrrd .nhdr .mhd .mha .vtk .vti "
+                  ".nii .nii.gz) instead of the input's boundary; boundary vertices off it are pinned");
+  cmd->add_option("--iso", a->iso, "With --volume: the isovalue");
+  cmd->add_option("--inside", a->inside, "With --volume: which side of the isovalue is the solid (default above)")
+      ->check(CLI::IsMember({"above", "below"}));
   cmd->add_option("--feature-angle", a->feature_angle,
                   "With --boundary slide: boundary edges bent by more than this many degrees are features (default 30)")
       ->check(CLI::Range(0.0, 180.0));

@@ -2,13 +2,16 @@
 
 #include "isohex/contour/dual_contour.hpp"
 #include "isohex/optimize/optimize.hpp"
+#include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/report.hpp"
 #include "isohex/sheets/pillow.hpp"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <sys/resource.h>
 
 namespace isohex::cli {
@@ -92,14 +95,41 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
   return j;
 }
 
-nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left) {
-  const std::vector<std::uint8_t> fixed = fixed_mask(mesh, FixedVertices::boundary);
+nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide) {
+  std::unique_ptr<BoundarySurface> surface;
+  if (slide.field) {
+    // Boundary vertices that extraction did not place on this isosurface (box faces, another
+    // surface) stay where they are.
+    std::vector<std::uint8_t> pin;
+    if (slide.vertex_place) {
+      pin.assign(mesh.points.size(), 0);
+      for (std::size_t v = 0; v < pin.size() && v < slide.vertex_place->size(); ++v)
+        pin[v] = (*slide.vertex_place)[v] != slide.surface;
+    }
+    surface = std::make_unique<BoundarySurface>(mesh, *slide.field, slide.feature_degrees, &pin);
+    fmt::print("boundary: {} vertices slide on the isosurface, {} pinned (off it{})\n", surface->num_sliding(),
+               surface->num_pinned(),
+               slide.feature_degrees < 180 ? fmt::format(", or on creases > {} degrees", slide.feature_degrees) : "");
+  }
+  const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(mesh, FixedVertices::boundary);
   OptimizeOptions o;
+  o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
   if (terminal) {
     const ProgressCallback progress = progress_printer(stdout);
     o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
   }
   nlohmann::json j = run_optimisation(mesh, fixed, o);
+  if (surface) {
+    double far = 0;
+    for (Index v = 0; v < mesh.num_vertices(); ++v)
+      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(mesh.points[v]));
+    j["boundary"] = {{"mode", "slide"},
+                     {"sliding", surface->num_sliding()},
+                     {"pinned", surface->num_pinned()},
+                     {"max_relative_level", far}};
+  } else {
+    j["boundary"] = {{"mode", "fixed"}};
+  }
   const MetricSummary s = summarize(HexMetric::scaled_jacobian, scaled_jacobians(mesh), 0);
   inverted_left = s.inverted + s.degenerate;
   return j;

@@ -2,6 +2,7 @@
 // The stages `isohex mesh` runs after extraction and surface smoothing: boundary pillowing,
 // untangling + shape optimisation with the boundary fixed, and the per-stage summary table.
 
+#include "isohex/contour/iso_field.hpp"
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/quality/summary.hpp"
@@ -41,10 +42,20 @@ ProgressCallback progress_printer(std::FILE* out);
 /// reason; shape; worst). Returns the JSON facts ("untangle", "shape", "worst").
 nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options);
 
-/// `isohex mesh`'s stage: run_optimisation() with the boundary fixed and default options (the
-/// same as `isohex smooth --untangle`). Returns the JSON facts of the stage; `inverted_left` is
-/// set to the hexes still inverted or degenerate at the end.
-nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left);
+/// How `isohex mesh`'s optimisation treats the boundary: fixed (null field), or sliding on the
+/// isosurface of `field` (`--boundary slide`), the vertices that `vertex_place` does not put on
+/// that surface (index `surface`) and those on creases sharper than `feature_degrees` pinned.
+struct SlideSpec {
+  const IsoField* field = nullptr;
+  const std::vector<std::int8_t>* vertex_place = nullptr;
+  int surface = 0;
+  double feature_degrees = 30;
+};
+
+/// `isohex mesh`'s stage: run_optimisation() with the boundary fixed (or sliding, see SlideSpec)
+/// and default options (the same as `isohex smooth --untangle`). Returns the JSON facts of the
+/// stage; `inverted_left` is set to the hexes still inverted or degenerate at the end.
+nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide = {});
 
 /// Prints the table of rows (hexes, vertices, min/mean SJ, #<0, #<0.2, time).
 void print_stage_table(const std::vector<StageRow>& rows);

@@ -6,6 +6,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/volume/volume_io.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -171,4 +172,170 @@ TEST(OptimizeSlide, CliSlidesAndRefusesOtherFixedModes) {
   EXPECT_NE(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "x.vtk") + " --boundary slide --fixed none", &out), 0);
   EXPECT_NE(out.find("--fixed"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.vtk"));
+}
+
+// ---- Sliding on the isosurface of a sampled field (--boundary slide --volume / isohex mesh).
+
+namespace {
+
+// |p| sampled on a grid over [-1.5, 1.5]³: the unit sphere is its isosurface 1 (inside below).
+Volume distance_volume(int n) {
+  Volume v;
+  v.dims = {n, n, n};
+  const double h = 3.0 / (n - 1);
+  v.spacing = Vec3(h, h, h);
+  v.origin = Vec3(-1.5, -1.5, -1.5);
+  v.values.resize(v.size());
+  for (Index k = 0; k < n; ++k)
+    for (Index j = 0; j < n; ++j)
+      for (Index i = 0; i < n; ++i) v.at(i, j, k) = static_cast<float>(v.point(i, j, k).norm());
+  return v;
+}
+
+// A ball whose boundary vertices are on the field's isosurface but badly spread over it: each
+// is moved tangentially by up to ~0.3 of an edge (a jitter), then projected back.
+HexMesh distorted_iso_ball(const IsoField& field) {
+  HexMesh m = ball_mesh(6);
+  HexMesh j = m;
+  jitter(j, 0.3 / 6, 11);
+  const auto boundary = boundary_vertex_mask(m);
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    if (!boundary[v]) continue;
+    const Vec3 n = m.points[v].normalized();
+    Vec3 d = j.points[v] - m.points[v];
+    d -= n * n.dot(d);
+    Vec3 p = m.points[v] + d;
+    EXPECT_TRUE(field.project(p, 0.5, 1e-8 * field.value_range())) << v;
+    m.points[v] = p;
+  }
+  return m;
+}
+
+Outcome optimise_iso(const HexMesh& in, const IsoField* field, int threads) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  Outcome r{in};
+  std::unique_ptr<BoundarySurface> surface;
+  if (field) surface = std::make_unique<BoundarySurface>(in, *field);
+  const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(in, FixedVertices::boundary);
+  OptimizeOptions o;
+  o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
+  optimize_mesh(r.mesh, fixed, o);
+  r.objective = shape_objective(r.mesh);
+  r.min_sj = 1;
+  for (double q : scaled_jacobians(r.mesh)) {
+    r.min_sj = std::min(r.min_sj, is_degenerate(q) ? -1.0 : q);
+    r.inverted += q <= 0 || is_degenerate(q);
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(OptimizeSlide, IsosurfaceSlidingStaysOnTheSampledSphere) {
+  const Volume volume = distance_volume(41);
+  const IsoField field(volume, 1.0, Inside::below);
+  const HexMesh in = distorted_iso_ball(field);
+  const BoundarySurface surface(in, field);
+  EXPECT_EQ(surface.field(), &field);
+  EXPECT_EQ(surface.num_pinned(), 0u);
+  EXPECT_GT(surface.num_sliding(), 100u);
+  const Outcome fixed = optimise_iso(in, nullptr, 2);
+  const Outcome slide = optimise_iso(in, &field, 2);
+  EXPECT_EQ(slide.inverted, 0u);
+  const double on = 1e-6 * field.value_range();
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < in.points.size(); ++v) {
+    if (surface.role(static_cast<Index>(v)) != BoundarySurface::Role::slides) continue;
+    moved += slide.mesh.points[v] != in.points[v];
+    ASSERT_LE(std::abs(field.level(slide.mesh.points[v])), on) << v;
+    ASSERT_LE(surface.deviation(slide.mesh.points[v]), 1e-6) << v;
+  }
+  EXPECT_GT(moved, 50u);
+  EXPECT_GT(slide.min_sj, fixed.min_sj);
+  EXPECT_LT(slide.objective, fixed.objective);
+  // The same bits with one thread.
+  const Outcome one = optimise_iso(in, &field, 1);
+  EXPECT_EQ(one.mesh.points, slide.mesh.points);
+}
+
+TEST(OptimizeSlide, IsosurfacePinsVerticesOffIt) {
+  const Volume volume = distance_volume(41);
+  const IsoField field(volume, 1.0, Inside::below);
+  HexMesh in = distorted_iso_ball(field);
+  const auto boundary = boundary_vertex_mask(in);
+  // One boundary vertex pushed off the isosurface, one pinned by the extra mask.
+  Index off = -1, extra = -1;
+  for (Index v = 0; v < in.num_vertices(); ++v)
+    if (boundary[v]) (off < 0 ? off : extra) = v;  // the last boundary vertex becomes `extra`
+  ASSERT_GE(off, 0);
+  ASSERT_GE(extra, 0);
+  in.points[off] *= 1.01;
+  std::vector<std::uint8_t> pin(in.points.size(), 0);
+  pin[extra] = 1;
+  const BoundarySurface surface(in, field, 30.0, &pin);
+  EXPECT_EQ(surface.num_pinned(), 2u);
+  EXPECT_EQ(surface.role(off), BoundarySurface::Role::pinned);
+  EXPECT_EQ(surface.role(extra), BoundarySurface::Role::pinned);
+  const auto fixed = surface.fixed_mask();
+  EXPECT_TRUE(fixed[off] && fixed[extra]);
+}
+
+TEST(OptimizeSlide, MeshCliSlidesOnTheIsosurface) {
+  const auto dir = scratch_dir();
+  std::string out_fixed, out_slide;
+  const std::string base = "mesh --shape 'sphere(0,0,0,1)' --resolution 12 ";
+  ASSERT_EQ(run_cli(base + "-o " + quote(dir / "fixed.vtu") + " --json " + quote(dir / "fixed.json"), &out_fixed), 0)
+      << out_fixed;
+  ASSERT_EQ(run_cli(base + "--boundary slide -o " + quote(dir / "slide.vtu") + " --json " + quote(dir / "slide.json"),
+                    &out_slide),
+            0)
+      << out_slide;
+  EXPECT_NE(out_slide.find("slide on the isosurface"), std::string::npos) << out_slide;
+  EXPECT_NE(out_slide.find("valid conformal mesh, closed manifold"), std::string::npos) << out_slide;
+  EXPECT_NE(out_slide.find("(0 above 1e-6"), std::string::npos) << out_slide;
+  const HexMesh fixed = io::read_mesh(dir / "fixed.vtu"), slide = io::read_mesh(dir / "slide.vtu");
+  const auto min_sj = [](const HexMesh& m) {
+    double q = 1;
+    for (double s : scaled_jacobians(m)) q = std::min(q, is_degenerate(s) ? -1.0 : s);
+    return q;
+  };
+  EXPECT_GE(min_sj(slide), min_sj(fixed)) << out_fixed << out_slide;
+  // Regions with more than one surface are refused.
+  EXPECT_NE(run_cli("mesh --shape 'sphere(0,0,0,1)' --resolution 8 --region outside --outer sphere:0,0,0,2 "
+                    "--boundary slide -o " + quote(dir / "x.vtu"),
+                    &out_slide),
+            0);
+  EXPECT_NE(out_slide.find("one isosurface"), std::string::npos) << out_slide;
+}
+
+TEST(OptimizeSlide, SmoothCliSlidesOnAVolumesIsosurface) {
+  const auto dir = scratch_dir();
+  const Volume volume = distance_volume(41);
+  write_volume(dir / "d.vti", volume);
+  const IsoField field(volume, 1.0, Inside::below);
+  io::write_mesh(dir / "in.vtk", distorted_iso_ball(field));
+  std::string out;
+  ASSERT_EQ(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "out.vtk") + " --boundary slide --volume " +
+                        quote(dir / "d.vti") + " --iso 1 --inside below --json " + quote(dir / "r.json"),
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("slide on the isosurface"), std::string::npos) << out;
+  std::ifstream json(dir / "r.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"max_relative_level\""), std::string::npos) << text;
+  // Every boundary vertex of the output on the isosurface.
+  const HexMesh m = io::read_mesh(dir / "out.vtk");
+  const auto boundary = boundary_vertex_mask(m);
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    if (boundary[v]) ASSERT_LE(std::abs(field.level(m.points[v])), 1e-6 * field.value_range()) << v;
+  // --volume without --boundary slide or without --iso is refused.
+  EXPECT_NE(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "x.vtk") + " --volume " + quote(dir / "d.vti") +
+                        " --iso 1",
+                    &out),
+            0);
+  EXPECT_NE(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "x.vtk") + " --boundary slide --volume " +
+                        quote(dir / "d.vti"),
+                    &out),
+            0);
 }

@@ -188,13 +188,14 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   const double floor = std::max(1e-6 * lam.cwiseAbs().maxCoeff(), 1e-3 * g.norm() / len);
   for (int i = 0; i < 3; ++i) lam[i] = std::max(lam[i], floor);
   Vec3 d = -(es.eigenvectors() * (es.eigenvectors().transpose() * g).cwiseQuotient(lam));
-  // A sliding boundary vertex steps in the tangent plane of the original surface where it is
-  // and is put back on that surface (on the same side: the facing test), so the energy is
-  // compared at points of the surface only.
+  // A sliding boundary vertex steps in the tangent plane of the target surface (the original
+  // boundary or an isosurface) where it is and is put back on that surface (on the same side:
+  // the facing test), so the energy is compared at points of the surface only. A step that
+  // cannot be put back is refused.
   const bool slides = params.surface && params.surface->role(v) == BoundarySurface::Role::slides;
   Vec3 n = Vec3::Zero();
   if (slides) {
-    params.surface->project(m.x, nullptr, &n);
+    if (!params.surface->tangent_normal(m.x, n)) return m;
     d -= n * n.dot(d);
   }
   const double dn = d.norm();
@@ -203,7 +204,8 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   const double slope = g.dot(d);
   double t = 1;
   for (int i = 0; i < 30; ++i, t *= 0.5) {
-    const Vec3 x = slides ? params.surface->project(m.x + t * d, &n) : Vec3(m.x + t * d);
+    Vec3 x = m.x + t * d;
+    if (slides && !params.surface->reproject(x, n, len)) continue;
     const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
     if (e < e0 && e <= e0 + 1e-4 * t * slope) {
       m.x = x;

@@ -38,7 +38,8 @@
 ///   the minimum scaled Jacobian (Verdict's) of the hexes around the vertex rises.
 ///
 /// With a BoundarySurface (slide.hpp) in the options, its sliding boundary vertices move too:
-/// tangential steps, put back on the input's boundary surface.
+/// tangential steps, put back on the input's boundary surface or on an IsoField's isosurface
+/// (a step that cannot be put back on the isosurface is refused).
 
 #include "isohex/mesh/hex_mesh.hpp"
 

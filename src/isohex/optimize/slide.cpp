@@ -38,6 +38,58 @@ Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3
 }  // namespace
 
 BoundarySurface::BoundarySurface(const HexMesh& mesh, double feature_degrees) {
+  classify(mesh, feature_degrees, true);
+}
+
+BoundarySurface::BoundarySurface(const HexMesh& mesh, const IsoField& field, double feature_degrees,
+                                 const std::vector<std::uint8_t>* pin)
+    : field_(&field), tol_(1e-7 * field.value_range()) {
+  classify(mesh, feature_degrees, false);
+  // Boundary vertices off the isosurface (on the box faces, or given) cannot slide on it.
+  const double on = 1e-6 * field.value_range();
+  for (std::size_t v = 0; v < role_.size(); ++v) {
+    if (role_[v] != static_cast<std::uint8_t>(Role::slides)) continue;
+    const bool extra = pin && v < pin->size() && (*pin)[v] != 0;
+    if (extra || !(std::abs(field.level(mesh.points[v])) <= on)) role_[v] = static_cast<std::uint8_t>(Role::pinned);
+  }
+  sliding_ = pinned_ = 0;
+  for (std::uint8_t r : role_) {
+    sliding_ += r == static_cast<std::uint8_t>(Role::slides);
+    pinned_ += r == static_cast<std::uint8_t>(Role::pinned);
+  }
+}
+
+bool BoundarySurface::tangent_normal(const Vec3& x, Vec3& n) const {
+  if (!field_) {
+    n = Vec3::Zero();
+    project(x, nullptr, &n);
+    return true;
+  }
+  Vec3 g;
+  field_->level(x, g);
+  const double gn = g.norm();
+  if (!(gn > 0) || !std::isfinite(gn)) return false;
+  n = -g / gn;  // outward: L is positive inside
+  return true;
+}
+
+bool BoundarySurface::reproject(Vec3& x, const Vec3& n, double len) const {
+  if (!field_) {
+    x = project(x, &n);
+    return true;
+  }
+  Vec3 p = x;
+  if (!field_->project(p, len, tol_)) return false;
+  x = p;
+  return true;
+}
+
+double BoundarySurface::deviation(const Vec3& x) const {
+  if (field_) return field_->value_range() > 0 ? std::abs(field_->level(x)) / field_->value_range() : std::abs(field_->level(x));
+  return (project(x) - x).norm();
+}
+
+void BoundarySurface::classify(const HexMesh& mesh, double feature_degrees, bool keep_triangles) {
   const std::vector<Quad> quads = boundary_quads(mesh);
   role_.assign(mesh.points.size(), static_cast<std::uint8_t>(Role::interior));
   std::vector<Vec3> qn(quads.size());
@@ -54,6 +106,7 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, double feature_degrees) {
       edge_sum += (P((i + 1) % 4) - P(i)).norm();
       role_[a] = static_cast<std::uint8_t>(Role::slides);
     }
+    if (!keep_triangles) continue;
     for (const auto& t : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
       tris_.push_back({P(t[0]), P(t[1]), P(t[2])});
       const Vec3 tn = (P(t[1]) - P(t[0])).cross(P(t[2]) - P(t[0]));

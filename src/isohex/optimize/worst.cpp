@@ -57,11 +57,11 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySur
   }
   if (!(g.norm() > 0)) return false;
   Vec3 d = g.normalized() * len;
-  // A sliding boundary vertex: tangential steps, put back on the original surface.
+  // A sliding boundary vertex: tangential steps, put back on the target surface.
   const bool slides = surface && surface->role(v) == BoundarySurface::Role::slides;
   Vec3 n = Vec3::Zero();
   if (slides) {
-    surface->project(x0, nullptr, &n);
+    if (!surface->tangent_normal(x0, n)) return false;
     d -= n * n.dot(d);
   }
   // The best of the halving steps, not the first that gains: the first overshoots (the
@@ -70,7 +70,8 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySur
   double t = 0.2, best = m0;
   Vec3 best_x = x0;
   for (int i = 0; i < 12; ++i, t *= 0.5) {
-    const Vec3 x = slides ? surface->project(x0 + t * d, &n) : Vec3(x0 + t * d);
+    Vec3 x = x0 + t * d;
+    if (slides && !surface->reproject(x, n, len)) continue;  // off the surface: refused
     bool valid = false;
     int below = 0;
     // Raising the local minimum is not enough when it is negative: a valid neighbour must
