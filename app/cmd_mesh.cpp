@@ -40,7 +40,9 @@ struct Args {
   std::vector<double> spacing, origin;
   std::size_t header_bytes = 0;
   bool no_surface_smoothing = false, no_pillow = false, no_smooth = false;
-  bool slide = false;  ///< --boundary slide: boundary vertices slide on the isosurface in the optimisation
+  /// --boundary: slide (boundary vertices slide on the isosurface in the optimisation) or fixed;
+  /// unset: slide where the region allows it (one isosurface), fixed elsewhere.
+  std::optional<bool> slide;
   int surface_iterations = 30;
   std::optional<double> feature_angle;
   int* threads = nullptr;
@@ -151,10 +153,12 @@ void run(const Args& a) {
     spec.outer = contour::parse_outer(a.outer);
   }
   const contour::Region region = contour::make_region(volume, spec);
-  if (a.slide && (a.no_smooth || region.surfaces.size() != 1 || !region.surfaces[0].field()))
+  const bool can_slide = !a.no_smooth && region.surfaces.size() == 1 && region.surfaces[0].field();
+  const bool slides = a.slide.value_or(can_slide);
+  if (slides && !can_slide)
     throw Error(a.no_smooth ? "--boundary slide acts in the optimisation stage, which --no-smooth skips"
                             : "--boundary slide needs a region bounded by one isosurface (--region inside, or outside "
-                              "up to the volume's box); use the default --boundary fixed");
+                              "up to the volume's box); use --boundary fixed");
 
   contour::ExtractOptions opt;
   opt.cell_size = cell_size > 0 ? cell_size : 0;
@@ -205,7 +209,7 @@ void run(const Args& a) {
   if (!a.no_smooth) {
     t = Clock::now();
     SlideSpec slide;
-    if (a.slide) slide = {region.surfaces[0].field(), &out.vertex_place, 0, feature_angle};
+    if (slides) slide = {region.surfaces[0].field(), &out.vertex_place, 0, feature_angle};
     optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide);
     rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t)));
     rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
@@ -352,12 +356,12 @@ void register_mesh(CLI::App& app) {
   cmd->add_flag("--no-pillow", a->no_pillow,
                 "Skip boundary pillowing (on by default: a sheet of hexes inside the boundary, surface unchanged)");
   cmd->add_flag("--no-smooth", a->no_smooth,
-                "Skip untangling and mean-ratio optimisation (on by default; boundary vertices fixed)");
+                "Skip untangling and mean-ratio optimisation (on by default; see --boundary)");
   const std::map<std::string, bool> boundary_names{{"fixed", false}, {"slide", true}};
   cmd->add_option("--boundary", a->slide,
-                  "Boundary vertices in the optimisation: fixed (default) or slide (move on the isosurface, "
-                  "reprojected onto it; crease (--feature-angle) and box-face vertices pinned; one-isosurface "
-                  "regions only)")
+                  "Boundary vertices in the optimisation: slide (move on the isosurface, reprojected onto it; "
+                  "crease (--feature-angle) and box-face vertices pinned; the default where the region has one "
+                  "isosurface) or fixed (where they are after surface smoothing; the default for other regions)")
       ->transform(CLI::CheckedTransformer(boundary_names, CLI::ignore_case));
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");

@@ -49,18 +49,16 @@ def cases(data, tmp):
                                                  "3.2", "--interpolation", "smooth-cubic"] + HEADSQ, None),
         ("MR head (iso 40, h 4, smooth-cubic)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "4",
                                                 "--interpolation", "smooth-cubic"], None),
-        # The boundary vertices slide on the isosurface during the optimisation (`--boundary
-        # slide`) instead of staying where the surface smoothing left them.
-        ("cthead (skin, h 4, slide)", "head", [v("cthead_256x256x113_int16be.raw"), "--iso", "600", "--cell-size", "4",
-                                        "--boundary", "slide"] + CTHEAD, None),
-        ("headsq (bone, h 3.2, slide)", "head", [v("headsq_64x64x93_int16le.raw"), "--iso", "1150", "--cell-size", "3.2",
-                                          "--boundary", "slide"] + HEADSQ, None),
-        ("mAChE (iso 1, h 1, slide)", "mAChE", [mache, "--iso", "1", "--cell-size", "1", "--boundary", "slide"],
+        # The paper's fixed boundary in the optimisation (`--boundary fixed`) instead of the
+        # default, where boundary vertices slide on the isosurface.
+        ("cthead (skin, h 4, fixed boundary)", "head", [v("cthead_256x256x113_int16be.raw"), "--iso", "600", "--cell-size",
+                                                 "4", "--boundary", "fixed"] + CTHEAD, None),
+        ("headsq (bone, h 3.2, fixed boundary)", "head", [v("headsq_64x64x93_int16le.raw"), "--iso", "1150", "--cell-size",
+                                                   "3.2", "--boundary", "fixed"] + HEADSQ, None),
+        ("mAChE (iso 1, h 1, fixed boundary)", "mAChE", [mache, "--iso", "1", "--cell-size", "1", "--boundary", "fixed"],
          ["volume", "molecule", os.path.join(data, "molecules", "mache_1MAH.pqr"), "-o", mache]),
-        ("MR head (iso 40, h 4, slide)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "4",
-                                         "--boundary", "slide"], None),
-        ("MR head (iso 40, h 4, smooth-cubic, slide)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "4",
-                                                       "--interpolation", "smooth-cubic", "--boundary", "slide"], None),
+        ("MR head (iso 40, h 4, fixed boundary)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "4",
+                                                  "--boundary", "fixed"], None),
     ]
 
 

@@ -224,17 +224,13 @@ def hex_boundary(mesh_file):
 
 
 # The repair flips samples where an inside component's complement in a cell falls apart.
-# Simple flips and cavity moves (a one-sample cavity removed and made again nearby) keep
-# marching cubes' topology, which the test checks by running marching cubes on the samples
+# Simple flips, cavity moves (a one-sample cavity removed and made again nearby) and tunnel
+# moves (a tunnel closed and another opened beside it) keep marching cubes' topology, which the test checks by running marching cubes on the samples
 # with those flips applied. Where neither finds a fix, the flip is forced and may change the
 # topology; the mesh must then still match marching cubes on the samples with every flip
 # applied, and the case is listed here with the largest difference allowed (components,
 # Euler characteristic) and the measured reason, so that a regression still fails.
 KNOWN_TOPOLOGY_DIFFERENCES = {
-    "cthead-h1": (0, 4, "4 forced flips of 1,653: two cells where two one-sample-thick pillars, each touching the "
-                       "other only along a cell edge, meet a solid slab (no sequence of simple flips up to 5 from the "
-                       "cell's corners, or of 3 prepared from its neighbours, mends them): Euler -248 vs -252, "
-                       "components equal (433, after 2 zero-volume cavities)"),
 }
 # Both surfaces have their vertices on the isosurface and chord it in between; with one vertex
 # per cell instead of one per cell edge the quads chord it about 1.7 times deeper than marching

@@ -1,6 +1,7 @@
 #include "isohex/contour/sampled_grid.hpp"
 
 #include "isohex/contour/cell_cases.hpp"
+#include "isohex/contour/handle_move.hpp"
 #include "isohex/contour/simple_point.hpp"
 #include "isohex/error.hpp"
 
@@ -11,8 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <cstdio>
-#include <cstdlib>
 
 namespace isohex::contour {
 
@@ -180,6 +179,8 @@ bool simple_at(const SampledGrid& g, std::size_t p) {
   return is_simple_6_18(nb);
 }
 
+}  // namespace
+
 // Not padding, and next to the isosurface: some 26-neighbour was sampled on the other side
 // (the level's sign is the sample's own side). Flipping a point away from the surface would
 // leave its dual vertices no surface to be projected onto.
@@ -195,6 +196,8 @@ bool near_surface(const SampledGrid& g, std::size_t p) {
       }
   return false;
 }
+
+namespace {
 
 // A search for a short sequence of simple flips (each simple in the state the ones before
 // it leave) that lowers the number of non-manifold cells. The first flip is a corner of the
@@ -469,19 +472,20 @@ class CavityMove {
   std::size_t from_ = 0, to_ = 0;
 };
 
-// Each non-manifold cell in grid order gets a cavity move if it has one; sequential, so it is
-// deterministic. Returns the number of moves.
-std::size_t relocation_phase(SampledGrid& g, RepairCounts& counts, std::vector<std::size_t>& cells) {
+// Each non-manifold cell in grid order gets a move of two flips (`move(cell, a, b)`: a cavity
+// move or a tunnel move) if it has one; sequential, so it is deterministic. Returns the moves.
+template <typename Move>
+std::size_t relocation_phase(SampledGrid& g, RepairCounts& counts, std::vector<std::size_t>& cells, Move&& move) {
   ++counts.rounds;
-  CavityMove move(g);
   std::size_t moves = 0;
   const std::size_t from = counts.edits.size();
   for (std::size_t cell : cells) {
-    if (cell_case(g.cell_mask_at(cell)).manifold || !move.repair(cell)) continue;
-    counts.edits.push_back({move.from(), RepairKind::relocated});
-    counts.edits.push_back({move.to(), RepairKind::relocated});
-    ++counts.filled;
-    ++counts.carved;
+    std::size_t a = 0, b = 0;
+    if (cell_case(g.cell_mask_at(cell)).manifold || !move(cell, a, b)) continue;
+    for (std::size_t p : {a, b}) {
+      counts.edits.push_back({p, RepairKind::relocated});
+      ++(g.inside[p] ? counts.filled : counts.carved);
+    }
     counts.relocated += 2;
     ++moves;
   }
@@ -574,22 +578,15 @@ RepairCounts repair_manifold(SampledGrid& g) {
   // Where no short sequence exists: cavity moves, prepared sequences, the deep search, the
   // first that does anything; then short sequences again around what changed.
   while (!cells.empty()) {
-    if (relocation_phase(g, counts, cells) == 0 && simple_phase(g, counts, Search::prepared, cells) == 0 &&
-        simple_phase(g, counts, Search::deep, cells) == 0)
+    CavityMove cavity(g);
+    auto move_cavity = [&](std::size_t cell, std::size_t& a, std::size_t& b) {
+      return cavity.repair(cell) && (a = cavity.from(), b = cavity.to(), true);
+    };
+    auto tunnel = [&](std::size_t cell, std::size_t& a, std::size_t& b) { return move_tunnel(g, cell, a, b); };
+    if (relocation_phase(g, counts, cells, move_cavity) == 0 && simple_phase(g, counts, Search::prepared, cells) == 0 &&
+        simple_phase(g, counts, Search::deep, cells) == 0 && relocation_phase(g, counts, cells, tunnel) == 0)
       break;
     simple_phase(g, counts, Search::short_, cells);
-  }
-  if (const char* dump = std::getenv("ISOHEX_DUMP_BLOCK")) {  // DEBUG-TEMP
-    std::FILE* f = std::fopen(dump, "w");
-    for (std::size_t cell : cells) {
-      const std::size_t ci = cell % g.padded[0], cj = cell / g.padded[0] % g.padded[1], ck = cell / dz;
-      std::fprintf(f, "cell %zu %zu %zu mask %d\n", ci - 1, cj - 1, ck - 1, g.cell_mask_at(cell));
-      for (std::size_t k = ck - 5; k <= ck + 6; ++k)
-        for (std::size_t j = cj - 5; j <= cj + 6; ++j)
-          for (std::size_t i = ci - 5; i <= ci + 6; ++i)
-            std::fprintf(f, "p %zu %zu %zu %d %.9g\n", i - 1, j - 1, k - 1, g.inside[g.index(i, j, k)], g.level[g.index(i, j, k)]);
-    }
-    std::fclose(f);
   }
   const std::size_t simple_carved = counts.carved, simple_filled = counts.filled;
   const std::size_t before_carving = counts.edits.size();

@@ -61,7 +61,7 @@ struct RepairCounts {
   std::size_t carved = 0;     ///< inside points made outside
   std::size_t filled = 0;     ///< outside points made inside
   std::size_t simple = 0;     ///< of those, simple points (no change of topology)
-  std::size_t relocated = 0;  ///< of those, flips moving one-sample cavities (two per move; topology kept)
+  std::size_t relocated = 0;  ///< of those, flips moving one-sample cavities or tunnels (two per move; topology kept)
   std::size_t forced = 0;     ///< of those, edits that may change the topology
   std::size_t degenerate = 0;             ///< of the filled, points of zero-volume cavities
   std::size_t degenerate_components = 0;  ///< zero-volume cavities filled
@@ -95,6 +95,9 @@ struct RepairCounts {
 ///        without raising the count (a defect walked along a structure: two one-sample-thick
 ///        fingers joined at their base, zipped up to their tips), at most 20,000 simple-point
 ///        tests per cell;
+///     d. tunnel moves (handle_move.hpp): a corner of the cell whose flip closes or makes one
+///        tunnel or handle, and a point within 2 samples whose flip then undoes that change
+///        of genus, together lowering the count (one tunnel moved: topology kept);
 ///     then 1 again around what changed;
 ///  3. forced edits, in two monotone phases: while some cell has outside parts touching
 ///     along an edge, inside points are made outside (manifold_carve); then, while some cell

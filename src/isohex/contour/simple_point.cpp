@@ -70,14 +70,16 @@ int components(std::uint32_t set, int reach) {
 
 }  // namespace
 
-bool is_simple_6_18(const Neighbourhood& nb) {
+std::array<int, 2> topological_numbers_6_18(const Neighbourhood& nb) {
   std::uint32_t in = 0, out = 0;
   for (int p = 0; p < 27; ++p) {
     if (p == kCentre) continue;
     (nb[static_cast<std::size_t>(p)] ? in : out) |= 1u << p;
   }
   // T6+(x, X) = #C6(N6^3(x, X)), T18(x, X̄) = #C18(N18^2(x, X̄)).
-  return components(geodesic(in, 1, 3), 1) == 1 && components(geodesic(out, 2, 2), 2) == 1;
+  return {components(geodesic(in, 1, 3), 1), components(geodesic(out, 2, 2), 2)};
 }
+
+bool is_simple_6_18(const Neighbourhood& nb) { return topological_numbers_6_18(nb) == std::array<int, 2>{1, 1}; }
 
 }  // namespace isohex::contour

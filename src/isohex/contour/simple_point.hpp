@@ -23,4 +23,10 @@ using Neighbourhood = std::array<bool, 27>;
 /// True when the centre of `nb` is simple for (inside 6-adjacency, outside 18-adjacency).
 [[nodiscard]] bool is_simple_6_18(const Neighbourhood& nb);
 
+/// The topological numbers {T6+(x, X), T18(x, X̄)} of the centre of `nb` (is_simple_6_18 is
+/// both being 1). A fill of an outside centre with {1, 2} closes a tunnel or makes a cavity,
+/// a carve of an inside centre with {2, 1} opens a tunnel or cuts a component, depending on
+/// whether the two local parts meet elsewhere.
+[[nodiscard]] std::array<int, 2> topological_numbers_6_18(const Neighbourhood& nb);
+
 }  // namespace isohex::contour
