@@ -339,7 +339,7 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
   std::vector<std::uint8_t> on_isosurface(static_cast<std::size_t>(nv), 0);
   for (Index v : boundary) {
     if (!graph.on_feature[v]) sliding.push_back(v);
-    on_isosurface[v] = surface_detail::plane_axis(ctx, v) < 0 || surface_detail::on_rim(ctx, v);
+    on_isosurface[v] = !surface_detail::in_box_face(ctx, v);
   }
   worst_quad_passes(ctx, sliding, on_isosurface, options, report);
 
@@ -349,7 +349,7 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
 
   const double guarantee = kSurfaceGuarantee * field.value_range();
   for (Index v : boundary) {
-    if (surface_detail::plane_axis(ctx, v) >= 0 && !surface_detail::on_rim(ctx, v)) continue;  // a box face, not the isosurface
+    if (surface_detail::in_box_face(ctx, v)) continue;  // not on the isosurface
     const double l = std::abs(field.level(mesh.points[v]));
     report.max_level = std::max(report.max_level, l);
     if (l > guarantee) ++report.off_surface;

@@ -183,7 +183,7 @@ bool move_is_acceptable(const MoveContext& ctx, Index v, const Vec3& y, bool bou
 
 MoveOutcome move_boundary_vertex(const MoveContext& ctx, Index v, const Vec3& step) {
   const Vec3 x = ctx.mesh.points[v];
-  const bool on_surface = (plane_axis(ctx, v) >= 0 && !on_rim(ctx, v)) || std::abs(ctx.field.level(x)) <= ctx.level_tolerance;
+  const bool on_surface = in_box_face(ctx, v) || std::abs(ctx.field.level(x)) <= ctx.level_tolerance;
   const double reach = ctx.projection_reach * mean_boundary_edge(ctx, v);
   const bool has_step = step.squaredNorm() > 0 && step.allFinite();
   if (!has_step && on_surface) return MoveOutcome::none;

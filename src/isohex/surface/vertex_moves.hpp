@@ -53,6 +53,9 @@ inline bool on_rim(const MoveContext& ctx, Index v) {
   return ctx.planar && !ctx.planar->empty() && (*ctx.planar)[static_cast<std::size_t>(v)] >= 3;
 }
 
+/// True if `v` slides in a box face (off the isosurface), not on the isosurface or its rim.
+inline bool in_box_face(const MoveContext& ctx, Index v) { return plane_axis(ctx, v) >= 0 && !on_rim(ctx, v); }
+
 /// Unit normal of the boundary at `v` from its quads (the sum of their area vectors).
 Vec3 quads_normal(const MoveContext& ctx, Index v);
 

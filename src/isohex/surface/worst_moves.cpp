@@ -4,6 +4,8 @@
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/surface/vertex_moves.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -179,22 +181,26 @@ MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int
 std::vector<Vec3> turned_over_quads(const MoveContext& ctx, const std::vector<std::uint8_t>& on_isosurface) {
   const auto& g = ctx.graph;
   const auto& p = ctx.mesh.points;
+  // The field's normal once per vertex (a quad corner would ask four times), then each quad;
+  // every entry is written by one task: the same bits for any thread count.
+  std::vector<Vec3> normal(p.size(), Vec3::Zero());
+  tbb::parallel_for(std::size_t{0}, p.size(), [&](std::size_t v) {
+    if (g.on_boundary[v] && on_isosurface[v]) normal[v] = outward_normal(ctx, static_cast<Index>(v));
+  });
   std::vector<Vec3> turned(g.quads.size(), Vec3::Zero());
-  for (std::size_t i = 0; i < g.quads.size(); ++i) {
+  tbb::parallel_for(std::size_t{0}, g.quads.size(), [&](std::size_t i) {
     const Quad& q = g.quads[i];
     const Vec3 n = (p[q[2]] - p[q[0]]).cross(p[q[3]] - p[q[1]]);
-    Vec3 field = Vec3::Zero();
-    for (Index v : q)
-      if (on_isosurface[v]) field += outward_normal(ctx, v);
-    if (!(n.dot(field) < 0)) continue;
+    const Vec3 field = normal[q[0]] + normal[q[1]] + normal[q[2]] + normal[q[3]];
+    if (!(n.dot(field) < 0)) return;
     const Hex& h = ctx.mesh.hexes[g.quad_hex[i]];
     const auto& opposite = kHexFaces[static_cast<std::size_t>(g.quad_face[i] ^ 1)];  // faces pair up 0-1, 2-3, 4-5
     Vec3 across = 0.25 * (p[q[0]] + p[q[1]] + p[q[2]] + p[q[3]]);
     for (int c : opposite) across -= 0.25 * p[h[c]];
-    if (!(n.dot(across) < 0)) continue;
+    if (!(n.dot(across) < 0)) return;
     const double fl = field.norm(), al = across.norm();
     if (fl > 0 && al > 0) turned[i] = field / fl + across / al;
-  }
+  });
   return turned;
 }
 
