@@ -13,6 +13,7 @@ void register_convert(CLI::App& app);
 void register_generate(CLI::App& app);
 void register_mesh(CLI::App& app);
 void register_pillow(CLI::App& app);
+void register_refine(CLI::App& app);
 void register_sheets(CLI::App& app);
 void register_smooth(CLI::App& app);
 

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   isohex::cli::register_generate(app);
   isohex::cli::register_mesh(app);
   isohex::cli::register_pillow(app);
+  isohex::cli::register_refine(app);
   isohex::cli::register_sheets(app);
   isohex::cli::register_smooth(app);
   isohex::cli::register_volume(app);
