@@ -285,6 +285,25 @@ TEST(Refine, RandomMarksOnGeneratedMeshes) {
     // planar, within the bilinear-patch approximation where it is not.
     const double area = boundary_area(m);
     EXPECT_NEAR(boundary_area(r.mesh), area, kind == 0 ? 1e-12 : 0.02 * area);
+    // Sources: 2, 4 or 8 input vertices, ascending, whose box holds the new vertex; a new
+    // boundary vertex comes from an input edge or quad of boundary vertices.
+    const auto n_in = static_cast<std::size_t>(m.num_vertices());
+    ASSERT_EQ(r.source_offsets.size(), r.mesh.points.size() - n_in + 1);
+    const std::vector<std::uint8_t> in_boundary = boundary_vertex_mask(m), out_boundary = boundary_vertex_mask(r.mesh);
+    for (std::size_t v = n_in; v < r.mesh.points.size(); ++v) {
+      const auto* b = r.source_ids.data() + r.source_offsets[v - n_in];
+      const auto* e = r.source_ids.data() + r.source_offsets[v - n_in + 1];
+      const auto n = e - b;
+      ASSERT_TRUE(n == 2 || n == 4 || n == 8) << n;
+      ASSERT_TRUE(std::is_sorted(b, e) && std::adjacent_find(b, e) == e);
+      Eigen::AlignedBox3d box;
+      for (auto* s = b; s != e; ++s) box.extend(m.points[*s]);
+      EXPECT_TRUE(box.contains(r.mesh.points[v]) || box.exteriorDistance(r.mesh.points[v]) < 1e-12);
+      if (out_boundary[v]) {
+        EXPECT_LE(n, 4);
+        for (auto* s = b; s != e; ++s) EXPECT_TRUE(in_boundary[*s]);
+      }
+    }
     // Deterministic.
     const RefineResult again = refine(m, marks);
     EXPECT_EQ(again.mesh.hexes, r.mesh.hexes);

@@ -332,6 +332,8 @@ RefineResult refine(const HexMesh& mesh, std::vector<std::uint8_t> marked) {
     Vec3 x = Vec3::Zero();  // in sorted-id order, so every hex computes the same bits
     for (int i = 0; i < k.n; ++i) x += static_cast<double>(k.w[i].second) * mesh.points[k.w[i].first];
     out.points.push_back(x / static_cast<double>(kN * kN * kN));
+    for (int i = 0; i < k.n; ++i) r.source_ids.push_back(k.w[i].first);
+    r.source_offsets.push_back(static_cast<Index>(r.source_ids.size()));
     if (mesh.has_fixed()) {
       bool fixed = false;
       if (k.n == 2) fixed = fixed_edges.count({k.w[0].first, k.w[1].first}) != 0;

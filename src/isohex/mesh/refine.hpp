@@ -46,6 +46,13 @@ const char* refine_template_name(RefineTemplate t);
 struct RefineResult {
   HexMesh mesh;                        ///< the refined mesh (blocks inherited from the parent)
   std::vector<Index> parent_hex;       ///< per hex of `mesh`, the hex of the input it came from
+  /// The input vertices each new vertex is a weighted sum of (those with a nonzero weight,
+  /// ascending): for new vertex v (id ≥ the input's vertex count n), source_ids[
+  /// source_offsets[v − n] .. source_offsets[v − n + 1]). Two ids: on an input edge; four: on
+  /// an input quad; more: inside an input hex. Callers use it to tell which surface a new
+  /// boundary vertex lies on.
+  std::vector<Index> source_offsets{0};
+  std::vector<Index> source_ids;
   std::vector<std::uint8_t> marked;    ///< per input vertex, marked after promotion
   std::size_t marked_vertices = 0;     ///< vertices marked on input
   std::size_t promoted_vertices = 0;   ///< vertices marked by promotion
