@@ -10,7 +10,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sys/resource.h>
@@ -109,15 +108,18 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
       for (const contour::LevelSet& f : contour::box_faces(slide.region->domain)) surfaces.push_back(f);
       for (std::size_t v = 0; v < place.size(); ++v)
         for (std::size_t f = first; place[v] == contour::kBoxVertex && f < surfaces.size(); ++f)
-          if (std::abs(surfaces[f].level(mesh.points[v])) <= 10 * surfaces[f].tolerance()) place[v] = static_cast<std::int8_t>(f);
+          if (surfaces[f].on(mesh.points[v])) place[v] = static_cast<std::int8_t>(f);
     }
     surface = std::make_unique<BoundarySurface>(mesh, std::move(surfaces), place, slide.feature_degrees);
-    std::string on;
+    // " on the S" for one surface, ": a on the S, b on the T" for several.
+    std::vector<std::size_t> used;
     for (std::size_t k = 0; k < surface->surfaces().size(); ++k)
-      if (const std::size_t n = surface->num_sliding_on(k); n > 0)
-        on += fmt::format("{}{} on the {}", on.empty() ? "" : ", ", n, surface->surfaces()[k].describe());
-    fmt::print("boundary: {} vertices slide{}{}; {} pinned (on the domain box, where two surfaces meet{})\n",
-               surface->num_sliding(), on.empty() ? "" : ": ", on, surface->num_pinned(),
+      if (surface->num_sliding_on(k) > 0) used.push_back(k);
+    std::string on = used.size() == 1 ? " on the " + surface->surfaces()[used[0]].describe() : used.empty() ? "" : ":";
+    for (std::size_t i = 0; used.size() > 1 && i < used.size(); ++i)
+      on += fmt::format("{} {} on the {}", i ? "," : "", surface->num_sliding_on(used[i]), surface->surfaces()[used[i]].describe());
+    fmt::print("boundary: {} vertices slide{}; {} pinned (on the domain box, where two surfaces meet{})\n",
+               surface->num_sliding(), on, surface->num_pinned(),
                slide.feature_degrees < 180 ? fmt::format(", or on creases > {} degrees", slide.feature_degrees) : "");
   }
   const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(mesh, FixedVertices::boundary);

@@ -293,7 +293,7 @@ TEST(OptimizeSlide, MeshCliSlidesOnTheIsosurface) {
                     &out_slide),
             0)
       << out_slide;
-  EXPECT_NE(out_slide.find("on the isosurface"), std::string::npos) << out_slide;
+  EXPECT_NE(out_slide.find("slide on the isosurface"), std::string::npos) << out_slide;
   EXPECT_NE(out_slide.find("valid conformal mesh, closed manifold"), std::string::npos) << out_slide;
   EXPECT_NE(out_slide.find("(0 above 1e-6"), std::string::npos) << out_slide;
   const HexMesh fixed = io::read_mesh(dir / "fixed.vtu"), slide = io::read_mesh(dir / "slide.vtu");

@@ -13,6 +13,7 @@
 #include "isohex/contour/iso_field.hpp"
 #include "isohex/volume/implicit.hpp"
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -48,6 +49,9 @@ class LevelSet {
   /// |L| below which a point counts as on the surface: 1e-7 of the volume's value range
   /// (so |f − iso| ≤ 1e-7 × range), or 1e-10 of a sphere's radius or a box's largest side.
   [[nodiscard]] double tolerance() const { return tolerance_; }
+  /// True if p counts as on the surface for a mesh vertex placed there (a sliding vertex's
+  /// start): |L| ≤ 10 × tolerance, i.e. 1e-6 × range, 1e-9 × radius or side.
+  [[nodiscard]] bool on(const Vec3& p) const { return std::abs(level(p)) <= 10 * tolerance_; }
   /// The unit of relative distances: the value range of an isosurface, a sphere's radius, a
   /// box's largest side.
   [[nodiscard]] double scale() const { return scale_; }

@@ -62,14 +62,13 @@ void BoundarySurface::assign_targets(const HexMesh& mesh, const std::vector<std:
   // A vertex slides only on its own surface, and only when it is on it and on no other: where
   // two surfaces meet (a box's edges, a rim) it could slide along neither without cutting the
   // other's corner off the domain.
-  const auto on = [&](std::size_t k, const Vec3& p) { return std::abs(surfaces_[k].level(p)) <= 10 * surfaces_[k].tolerance(); };
   target_.assign(role_.size(), -1);
   for (std::size_t v = 0; v < role_.size(); ++v) {
     if (role_[v] != static_cast<std::uint8_t>(Role::slides)) continue;
     const int k = v < place.size() ? place[v] : -1;
     bool slides = k >= 0 && static_cast<std::size_t>(k) < surfaces_.size() && !(pin && v < pin->size() && (*pin)[v] != 0) &&
-                  on(static_cast<std::size_t>(k), mesh.points[v]);
-    for (std::size_t j = 0; slides && j < surfaces_.size(); ++j) slides = j == static_cast<std::size_t>(k) || !on(j, mesh.points[v]);
+                  surfaces_[static_cast<std::size_t>(k)].on(mesh.points[v]);
+    for (std::size_t j = 0; slides && j < surfaces_.size(); ++j) slides = j == static_cast<std::size_t>(k) || !surfaces_[j].on(mesh.points[v]);
     if (slides) target_[v] = static_cast<std::int8_t>(k);
     else role_[v] = static_cast<std::uint8_t>(Role::pinned);
   }

@@ -1,7 +1,7 @@
 #pragma once
 /// \file slide.hpp
 /// \brief The original boundary of a hex mesh as a surface on which boundary vertices slide
-/// during optimisation (`isohex smooth --boundary slide`).
+/// during optimisation (`isohex smooth --boundary slide`, `isohex mesh`).
 ///
 /// The boundary quads at construction are split into two triangles each (along the 0–2
 /// diagonal) and kept, unchanged, as the target: a sliding vertex's step is made tangential
@@ -16,7 +16,7 @@
 /// one local edge length, to the surface's tolerance: 1e-7 × value range, 1e-10 × radius or box
 /// side); when the projection fails the step is refused, so a sliding vertex never leaves its
 /// surface. Pinned: boundary vertices whose place is no surface, those not on it at
-/// construction (|L| > 10 × tolerance), those also on another of the surfaces (where two meet:
+/// construction (LevelSet::on), those also on another of the surfaces (where two meet:
 /// a crease, e.g. a box's edges), feature vertices, and those of an optional extra mask.
 /// The IsoField form is the one-surface case (every boundary vertex's place is the isosurface).
 
