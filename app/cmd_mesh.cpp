@@ -40,8 +40,8 @@ struct Args {
   std::vector<double> spacing, origin;
   std::size_t header_bytes = 0;
   bool no_surface_smoothing = false, no_pillow = false, no_smooth = false;
-  /// --boundary: slide (boundary vertices slide on the isosurface in the optimisation) or fixed;
-  /// unset: slide where the region allows it (one isosurface), fixed elsewhere.
+  /// --boundary: slide (boundary vertices slide on their surfaces in the optimisation) or fixed;
+  /// unset: slide unless --no-smooth.
   std::optional<bool> slide;
   int surface_iterations = 30;
   std::optional<double> feature_angle;
@@ -153,12 +153,13 @@ void run(const Args& a) {
     spec.outer = contour::parse_outer(a.outer);
   }
   const contour::Region region = contour::make_region(volume, spec);
-  const bool can_slide = !a.no_smooth && region.surfaces.size() == 1 && region.surfaces[0].field();
+  // Every surface a region can have (isosurfaces, the outer sphere, an outer box's faces) is a
+  // level set its vertices can slide on; only the optimisation stage slides them.
+  const bool can_slide = !a.no_smooth;
   const bool slides = a.slide.value_or(can_slide);
   if (slides && !can_slide)
-    throw Error(a.no_smooth ? "--boundary slide acts in the optimisation stage, which --no-smooth skips"
-                            : "--boundary slide needs a region bounded by one isosurface (--region inside, or outside "
-                              "up to the volume's box); use --boundary fixed");
+    throw Error("--boundary slide acts in the optimisation stage, which --no-smooth skips; use --boundary fixed or drop "
+                "--no-smooth");
 
   contour::ExtractOptions opt;
   opt.cell_size = cell_size > 0 ? cell_size : 0;
@@ -209,7 +210,7 @@ void run(const Args& a) {
   if (!a.no_smooth) {
     t = Clock::now();
     SlideSpec slide;
-    if (slides) slide = {region.surfaces[0].field(), &out.vertex_place, 0, feature_angle};
+    if (slides) slide = {&region, &out.vertex_place, spec.outer.kind == contour::OuterBoundary::Kind::box, feature_angle};
     optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide);
     rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t)));
     rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
@@ -243,6 +244,17 @@ void run(const Args& a) {
   fmt::print("  distance to the isosurface: max |f - iso| / range = {:.3g} over {} vertices ({} above 1e-6; {} box "
              "vertices not checked; {} projection fallbacks)\n",
              dist.max_relative, dist.checked, dist.off_surface, dist.box_vertices, r.projection_fallbacks);
+  if (region.surfaces.size() > 1 || dist.box_vertices > 0) {
+    // Each surface against its own scale (value range, radius), and the box vertices, which may
+    // slide in an outer box's faces, against the box.
+    std::string each;
+    for (std::size_t k = 0; k < region.surfaces.size(); ++k)
+      each += fmt::format("{}{}: {:.3g} over {}", k ? "; " : "", region.surfaces[k].describe(),
+                          dist.max_relative_per_surface[k], dist.checked_per_surface[k]);
+    if (dist.box_vertices > 0)
+      each += fmt::format("; domain box: {:.3g} (of its largest side) over {}", dist.box_max_relative, dist.box_vertices);
+    fmt::print("  distance to each surface (max |L| / scale): {}\n", each);
+  }
   print_summary(summary);
   fmt::print("times: read {:.3f} s, sample {:.3f} s, repair {:.3f} s, components {:.3f} s, vertices {:.3f} s, hexes "
              "{:.3f} s, surface smoothing {:.3f} s, check {:.3f} s, write {:.3f} s\n",
@@ -295,6 +307,13 @@ void run(const Args& a) {
     j["projection_fallbacks"] = r.projection_fallbacks;
     j["max_relative_distance"] = dist.max_relative;
     j["off_surface_vertices"] = dist.off_surface;
+    nlohmann::json per = nlohmann::json::array();
+    for (std::size_t k = 0; k < region.surfaces.size(); ++k)
+      per.push_back({{"surface", region.surfaces[k].describe()},
+                     {"max_relative_distance", dist.max_relative_per_surface[k]},
+                     {"vertices", dist.checked_per_surface[k]}});
+    j["surface_distances"] = per;
+    j["box_max_relative_distance"] = dist.box_max_relative;
     j["scaled_jacobian"] = to_json(summary);
     j["times"] = {{"read", read_time},          {"sample", r.time_sample}, {"repair", r.time_repair},
                   {"components", r.time_components}, {"vertices", r.time_vertices}, {"hexes", r.time_hexes},
@@ -359,9 +378,11 @@ void register_mesh(CLI::App& app) {
                 "Skip untangling and mean-ratio optimisation (on by default; see --boundary)");
   const std::map<std::string, bool> boundary_names{{"fixed", false}, {"slide", true}};
   cmd->add_option("--boundary", a->slide,
-                  "Boundary vertices in the optimisation: slide (move on the isosurface, reprojected onto it; "
-                  "crease (--feature-angle) and box-face vertices pinned; the default where the region has one "
-                  "isosurface) or fixed (where they are after surface smoothing; the default for other regions)")
+                  "Boundary vertices in the optimisation: slide (the default: each moves on its own surface, an "
+                  "isosurface, the --outer sphere or an --outer box's face, and is reprojected onto it; vertices on "
+                  "creases (--feature-angle), where two surfaces meet and on the domain box, unless that is the --outer "
+                  "box, pinned) or fixed "
+                  "(where they are after surface smoothing, the paper's setting)")
       ->transform(CLI::CheckedTransformer(boundary_names, CLI::ignore_case));
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");

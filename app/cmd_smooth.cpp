@@ -133,7 +133,7 @@ void run(const Args& a) {
     // (a distance for the input's boundary, |f - iso| / range for an isosurface).
     double far = 0;
     for (Index v = 0; v < mesh.num_vertices(); ++v)
-      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(mesh.points[v]));
+      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(v, mesh.points[v]));
     report["boundary"] = {{"mode", "slide"},       {"sliding", surface->num_sliding()},
                           {"pinned", surface->num_pinned()}, {"feature_angle", a.feature_angle},
                           {"target", field ? "isosurface" : "input boundary"}};

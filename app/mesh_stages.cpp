@@ -97,18 +97,29 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 
 nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide) {
   std::unique_ptr<BoundarySurface> surface;
-  if (slide.field) {
-    // Boundary vertices that extraction did not place on this isosurface (box faces, another
-    // surface) stay where they are.
-    std::vector<std::uint8_t> pin;
-    if (slide.vertex_place) {
-      pin.assign(mesh.points.size(), 0);
-      for (std::size_t v = 0; v < pin.size() && v < slide.vertex_place->size(); ++v)
-        pin[v] = (*slide.vertex_place)[v] != slide.surface;
+  if (slide.region) {
+    std::vector<contour::LevelSet> surfaces = slide.region->surfaces;
+    std::vector<std::int8_t> place = *slide.vertex_place;
+    place.resize(mesh.points.size(), contour::kInteriorVertex);
+    if (slide.outer_box) {
+      // A box vertex slides in the face it lies in; BoundarySurface pins those that lie in two
+      // (the box's edges and corners) or on an isosurface too (where it meets the box).
+      const std::size_t first = surfaces.size();
+      for (const contour::LevelSet& f : contour::box_faces(slide.region->domain)) surfaces.push_back(f);
+      for (std::size_t v = 0; v < place.size(); ++v)
+        for (std::size_t f = first; place[v] == contour::kBoxVertex && f < surfaces.size(); ++f)
+          if (surfaces[f].on(mesh.points[v])) place[v] = static_cast<std::int8_t>(f);
     }
-    surface = std::make_unique<BoundarySurface>(mesh, *slide.field, slide.feature_degrees, &pin);
-    fmt::print("boundary: {} vertices slide on the isosurface, {} pinned (off it{})\n", surface->num_sliding(),
-               surface->num_pinned(),
+    surface = std::make_unique<BoundarySurface>(mesh, std::move(surfaces), place, slide.feature_degrees);
+    // " on the S" for one surface, ": a on the S, b on the T" for several.
+    std::vector<std::size_t> used;
+    for (std::size_t k = 0; k < surface->surfaces().size(); ++k)
+      if (surface->num_sliding_on(k) > 0) used.push_back(k);
+    std::string on = used.size() == 1 ? " on the " + surface->surfaces()[used[0]].describe() : used.empty() ? "" : ":";
+    for (std::size_t i = 0; used.size() > 1 && i < used.size(); ++i)
+      on += fmt::format("{} {} on the {}", i ? "," : "", surface->num_sliding_on(used[i]), surface->surfaces()[used[i]].describe());
+    fmt::print("boundary: {} vertices slide{}; {} pinned (on the domain box, where two surfaces meet{})\n",
+               surface->num_sliding(), on, surface->num_pinned(),
                slide.feature_degrees < 180 ? fmt::format(", or on creases > {} degrees", slide.feature_degrees) : "");
   }
   const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(mesh, FixedVertices::boundary);
@@ -122,9 +133,13 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
   if (surface) {
     double far = 0;
     for (Index v = 0; v < mesh.num_vertices(); ++v)
-      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(mesh.points[v]));
+      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(v, mesh.points[v]));
+    nlohmann::json per = nlohmann::json::object();
+    for (std::size_t k = 0; k < surface->surfaces().size(); ++k)
+      if (const std::size_t n = surface->num_sliding_on(k); n > 0) per[surface->surfaces()[k].describe()] = n;
     j["boundary"] = {{"mode", "slide"},
                      {"sliding", surface->num_sliding()},
+                     {"sliding_per_surface", per},
                      {"pinned", surface->num_pinned()},
                      {"max_relative_level", far}};
   } else {

@@ -1,8 +1,8 @@
 #pragma once
 // The stages `isohex mesh` runs after extraction and surface smoothing: boundary pillowing,
-// untangling + shape optimisation with the boundary fixed, and the per-stage summary table.
+// untangling + shape optimisation with the boundary fixed or sliding, and the per-stage summary table.
 
-#include "isohex/contour/iso_field.hpp"
+#include "isohex/contour/region.hpp"
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/quality/summary.hpp"
@@ -42,13 +42,16 @@ ProgressCallback progress_printer(std::FILE* out);
 /// reason; shape; worst). Returns the JSON facts ("untangle", "shape", "worst").
 nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options);
 
-/// How `isohex mesh`'s optimisation treats the boundary: fixed (null field), or sliding on the
-/// isosurface of `field` (`--boundary slide`), the vertices that `vertex_place` does not put on
-/// that surface (index `surface`) and those on creases sharper than `feature_degrees` pinned.
+/// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
+/// (`--boundary slide`): each boundary vertex on its own surface, the one `vertex_place` names
+/// among region->surfaces. Vertices on the domain box are pinned, except where the box is an
+/// outer box (`outer_box`): there a vertex on one face slides in it, those on its edges and
+/// corners stay. Vertices where two surfaces meet, or on creases sharper than
+/// `feature_degrees`, are pinned (BoundarySurface).
 struct SlideSpec {
-  const IsoField* field = nullptr;
+  const contour::Region* region = nullptr;
   const std::vector<std::int8_t>* vertex_place = nullptr;
-  int surface = 0;
+  bool outer_box = false;
   double feature_degrees = 30;
 };
 

@@ -415,12 +415,22 @@ SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, cons
     const LevelSet& ls = region.surfaces[static_cast<std::size_t>(s)];
     rel[static_cast<std::size_t>(v)] = std::abs(ls.level(mesh.points[static_cast<std::size_t>(v)])) / ls.scale();
   });
+  d.max_relative_per_surface.assign(region.surfaces.size(), 0);
+  d.checked_per_surface.assign(region.surfaces.size(), 0);
+  const double side = (region.domain.hi - region.domain.lo).maxCoeff();
   for (std::size_t v = 0; v < rel.size(); ++v) {
-    if (place[v] == kBoxVertex) ++d.box_vertices;
+    if (place[v] == kBoxVertex) {
+      ++d.box_vertices;
+      const Vec3& p = mesh.points[v];
+      const double to_box = std::min((p - region.domain.lo).cwiseAbs().minCoeff(), (region.domain.hi - p).cwiseAbs().minCoeff());
+      d.box_max_relative = std::max(d.box_max_relative, to_box / side);
+    }
     if (rel[v] < 0) continue;
     ++d.checked;
     d.max_relative = std::max(d.max_relative, rel[v]);
     d.off_surface += rel[v] > 1e-6;
+    d.max_relative_per_surface[static_cast<std::size_t>(place[v])] = std::max(d.max_relative_per_surface[static_cast<std::size_t>(place[v])], rel[v]);
+    ++d.checked_per_surface[static_cast<std::size_t>(place[v])];
   }
   return d;
 }

@@ -125,6 +125,11 @@ struct SurfaceDistance {
   std::size_t checked = 0;      ///< surface vertices measured
   std::size_t off_surface = 0;  ///< of those, relative distance above 1e-6
   std::size_t box_vertices = 0; ///< vertices on the domain box, excluded
+  std::vector<double> max_relative_per_surface;    ///< per surface of the region
+  std::vector<std::size_t> checked_per_surface;    ///< per surface of the region
+  /// max over the box vertices of their distance to the domain box's surface / its largest side
+  /// (they may slide in its faces: optimize/slide.hpp).
+  double box_max_relative = 0;
 };
 SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, const std::vector<std::int8_t>& vertex_place);
 

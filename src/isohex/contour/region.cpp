@@ -21,7 +21,23 @@ LevelSet::LevelSet(std::shared_ptr<const IsoField> field) : field_(std::move(fie
 
 LevelSet::LevelSet(const Vec3& center, double radius) : center_(center), radius_(radius), tolerance_(1e-10 * radius), scale_(radius) {}
 
+LevelSet::LevelSet(const Aabb& box, int face) : face_(face), box_(box) {
+  if (face < 0 || face > 5 || box.is_empty() || !box.is_finite()) throw Error("LevelSet: a box face needs face 0-5 of a finite box");
+  scale_ = (box.hi - box.lo).maxCoeff();
+  tolerance_ = 1e-10 * scale_;
+}
+
+namespace {
+// A box face's inward unit normal: +e_a on the lower side, −e_a on the upper.
+Vec3 face_normal(int face) {
+  Vec3 n = Vec3::Zero();
+  n[face / 2] = face % 2 ? -1.0 : 1.0;
+  return n;
+}
+}  // namespace
+
 double LevelSet::level(const Vec3& p) const {
+  if (face_ >= 0) return face_ % 2 ? box_.hi[face_ / 2] - p[face_ / 2] : p[face_ / 2] - box_.lo[face_ / 2];
   if (!field_) return radius_ - (p - center_).norm();
   if (snap_to_grid_) {
     const Volume& v = field_->volume();
@@ -36,6 +52,10 @@ double LevelSet::level(const Vec3& p) const {
 }
 
 double LevelSet::level(const Vec3& p, Vec3& gradient) const {
+  if (face_ >= 0) {
+    gradient = face_normal(face_);
+    return level(p);
+  }
   if (!field_) {
     const Vec3 d = p - center_;
     const double n = d.norm();
@@ -50,6 +70,10 @@ Vec3 LevelSet::root(const Vec3& a, const Vec3& b) const {
   if (std::abs(level(b)) <= tolerance_) return b;
   if (std::abs(level(a)) <= tolerance_) return a;
   if (field_) return field_->root_on_segment(a, b, tolerance_);
+  if (face_ >= 0) {
+    const double la = level(a), lb = level(b);
+    return a + std::clamp(la / (la - lb), 0.0, 1.0) * (b - a);
+  }
   // Sphere: |a + t (b − a) − c| = r, the root in [0, 1] (a is inside).
   const Vec3 d = b - a, o = a - center_;
   const double qa = d.squaredNorm(), qb = 2 * o.dot(d), qc = o.squaredNorm() - radius_ * radius_;
@@ -58,6 +82,15 @@ Vec3 LevelSet::root(const Vec3& a, const Vec3& b) const {
 }
 
 bool LevelSet::project(Vec3& p, double max_distance) const {
+  if (face_ >= 0) {
+    // Onto the plane exactly, and only within the face: past its edges lies another face.
+    const int a = face_ / 2;
+    if (!(std::abs(level(p)) <= max_distance)) return false;
+    for (int j = 0; j < 3; ++j)
+      if (j != a && !(p[j] >= box_.lo[j] && p[j] <= box_.hi[j])) return false;
+    p[a] = face_ % 2 ? box_.hi[a] : box_.lo[a];
+    return true;
+  }
   if (std::abs(level(p)) <= tolerance_) return true;
   if (field_) return field_->project(p, max_distance, tolerance_);
   const Vec3 d = p - center_;
@@ -68,6 +101,8 @@ bool LevelSet::project(Vec3& p, double max_distance) const {
 }
 
 std::string LevelSet::describe() const {
+  if (face_ >= 0)
+    return fmt::format("box face {} = {:g}", "xyz"[face_ / 2], face_ % 2 ? box_.hi[face_ / 2] : box_.lo[face_ / 2]);
   if (!field_) return fmt::format("sphere ({:g}, {:g}, {:g}) radius {:g}", center_.x(), center_.y(), center_.z(), radius_);
   return fmt::format("isosurface {:g} (inside {})", field_->isovalue(), inside_name(field_->inside()));
 }
@@ -76,6 +111,12 @@ double Region::level(const Vec3& p) const {
   double l = std::numeric_limits<double>::infinity();
   for (const LevelSet& s : surfaces) l = std::min(l, s.level(p));
   return l;
+}
+
+std::vector<LevelSet> box_faces(const Aabb& box) {
+  std::vector<LevelSet> faces;
+  for (int f = 0; f < 6; ++f) faces.emplace_back(box, f);
+  return faces;
 }
 
 std::string_view region_name(RegionKind k) {

@@ -13,6 +13,7 @@
 #include "isohex/contour/iso_field.hpp"
 #include "isohex/volume/implicit.hpp"
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -20,13 +21,19 @@
 
 namespace isohex::contour {
 
-/// One bounding surface of a region: an isosurface of the volume or an analytic sphere.
+/// One bounding surface of a region: an isosurface of the volume or an analytic sphere; or a
+/// face of a box, which no Region holds (the box is its domain) but on which boundary vertices
+/// slide during optimisation (optimize/slide.hpp) like on the others.
 class LevelSet {
  public:
   /// The level set of `field` (which the LevelSet shares).
   explicit LevelSet(std::shared_ptr<const IsoField> field);
   /// The ball of `radius` about `center`: L = radius − |p − center|.
   LevelSet(const Vec3& center, double radius);
+  /// Face `face` of `box` (axis face / 2, the upper side if face is odd): L is the signed
+  /// distance to its plane, positive towards the box; project() only succeeds within the face
+  /// (its edges included), so a point never slides off it onto a neighbouring face.
+  LevelSet(const Aabb& box, int face);
 
   /// L(p). For an isosurface whose interpolant is exact at grid points (trilinear, cubic),
   /// a point within 1e-9 cells of a grid point takes the stored value exactly, so that
@@ -40,13 +47,17 @@ class LevelSet {
   /// Moves `p` onto the surface, at most `max_distance` away; true on success (|L| ≤ tolerance).
   bool project(Vec3& p, double max_distance) const;
   /// |L| below which a point counts as on the surface: 1e-7 of the volume's value range
-  /// (so |f − iso| ≤ 1e-7 × range), or 1e-10 of a sphere's radius.
+  /// (so |f − iso| ≤ 1e-7 × range), or 1e-10 of a sphere's radius or a box's largest side.
   [[nodiscard]] double tolerance() const { return tolerance_; }
-  /// The unit of relative distances: the value range of an isosurface, a sphere's radius.
+  /// True if p counts as on the surface for a mesh vertex placed there (a sliding vertex's
+  /// start): |L| ≤ 10 × tolerance, i.e. 1e-6 × range, 1e-9 × radius or side.
+  [[nodiscard]] bool on(const Vec3& p) const { return std::abs(level(p)) <= 10 * tolerance_; }
+  /// The unit of relative distances: the value range of an isosurface, a sphere's radius, a
+  /// box's largest side.
   [[nodiscard]] double scale() const { return scale_; }
-  /// The isosurface's field, or null for a sphere.
+  /// The isosurface's field, or null for a sphere or a box face.
   [[nodiscard]] const IsoField* field() const { return field_.get(); }
-  /// "isosurface 1150" or "sphere".
+  /// "isosurface 1150 (inside above)", "sphere (...) radius R" or "box face z = 0".
   [[nodiscard]] std::string describe() const;
 
  private:
@@ -54,6 +65,8 @@ class LevelSet {
   bool snap_to_grid_ = false;
   Vec3 center_{0, 0, 0};
   double radius_ = 0;
+  int face_ = -1;  // a box face (0–5), or −1
+  Aabb box_{Vec3::Zero(), Vec3::Zero()};
   double tolerance_ = 0;
   double scale_ = 1;
 };
@@ -65,6 +78,9 @@ struct Region {
   /// min_k L_k(p) (without the domain box).
   [[nodiscard]] double level(const Vec3& p) const;
 };
+
+/// The six faces of `box` as level sets (LevelSet(box, 0..5)).
+std::vector<LevelSet> box_faces(const Aabb& box);
 
 /// Which part of space around the isosurface to mesh.
 enum class RegionKind : unsigned char { inside, outside, between };

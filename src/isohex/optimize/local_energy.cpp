@@ -195,7 +195,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   const bool slides = params.surface && params.surface->role(v) == BoundarySurface::Role::slides;
   Vec3 n = Vec3::Zero();
   if (slides) {
-    if (!params.surface->tangent_normal(m.x, n)) return m;
+    if (!params.surface->tangent_normal(v, m.x, n)) return m;
     d -= n * n.dot(d);
   }
   const double dn = d.norm();
@@ -205,7 +205,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   double t = 1;
   for (int i = 0; i < 30; ++i, t *= 0.5) {
     Vec3 x = m.x + t * d;
-    if (slides && !params.surface->reproject(x, n, len)) continue;
+    if (slides && !params.surface->reproject(v, x, n, len)) continue;
     const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
     if (e < e0 && e <= e0 + 1e-4 * t * slope) {
       m.x = x;

@@ -42,15 +42,35 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, double feature_degrees) {
 }
 
 BoundarySurface::BoundarySurface(const HexMesh& mesh, const IsoField& field, double feature_degrees,
-                                 const std::vector<std::uint8_t>* pin)
-    : field_(&field), tol_(1e-7 * field.value_range()) {
+                                 const std::vector<std::uint8_t>* pin) {
+  // The field is not owned: the LevelSet gets a non-owning (aliasing) pointer to it.
+  surfaces_.emplace_back(std::shared_ptr<const IsoField>(std::shared_ptr<const IsoField>(), &field));
   classify(mesh, feature_degrees, false);
-  // Boundary vertices off the isosurface (on the box faces, or given) cannot slide on it.
-  const double on = 1e-6 * field.value_range();
+  assign_targets(mesh, std::vector<std::int8_t>(mesh.points.size(), 0), pin);
+}
+
+BoundarySurface::BoundarySurface(const HexMesh& mesh, std::vector<contour::LevelSet> surfaces,
+                                 const std::vector<std::int8_t>& place, double feature_degrees,
+                                 const std::vector<std::uint8_t>* pin)
+    : surfaces_(std::move(surfaces)) {
+  classify(mesh, feature_degrees, false);
+  assign_targets(mesh, place, pin);
+}
+
+void BoundarySurface::assign_targets(const HexMesh& mesh, const std::vector<std::int8_t>& place,
+                                     const std::vector<std::uint8_t>* pin) {
+  // A vertex slides only on its own surface, and only when it is on it and on no other: where
+  // two surfaces meet (a box's edges, a rim) it could slide along neither without cutting the
+  // other's corner off the domain.
+  target_.assign(role_.size(), -1);
   for (std::size_t v = 0; v < role_.size(); ++v) {
     if (role_[v] != static_cast<std::uint8_t>(Role::slides)) continue;
-    const bool extra = pin && v < pin->size() && (*pin)[v] != 0;
-    if (extra || !(std::abs(field.level(mesh.points[v])) <= on)) role_[v] = static_cast<std::uint8_t>(Role::pinned);
+    const int k = v < place.size() ? place[v] : -1;
+    bool slides = k >= 0 && static_cast<std::size_t>(k) < surfaces_.size() && !(pin && v < pin->size() && (*pin)[v] != 0) &&
+                  surfaces_[static_cast<std::size_t>(k)].on(mesh.points[v]);
+    for (std::size_t j = 0; slides && j < surfaces_.size(); ++j) slides = j == static_cast<std::size_t>(k) || !surfaces_[j].on(mesh.points[v]);
+    if (slides) target_[v] = static_cast<std::int8_t>(k);
+    else role_[v] = static_cast<std::uint8_t>(Role::pinned);
   }
   sliding_ = pinned_ = 0;
   for (std::uint8_t r : role_) {
@@ -59,34 +79,42 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, const IsoField& field, dou
   }
 }
 
-bool BoundarySurface::tangent_normal(const Vec3& x, Vec3& n) const {
-  if (!field_) {
+std::size_t BoundarySurface::num_sliding_on(std::size_t k) const {
+  return static_cast<std::size_t>(std::count(target_.begin(), target_.end(), static_cast<std::int8_t>(k)));
+}
+
+bool BoundarySurface::tangent_normal(Index v, const Vec3& x, Vec3& n) const {
+  if (surfaces_.empty()) {
     n = Vec3::Zero();
     project(x, nullptr, &n);
     return true;
   }
+  if (target(v) < 0) return false;
   Vec3 g;
-  field_->level(x, g);
+  surfaces_[target(v)].level(x, g);
   const double gn = g.norm();
   if (!(gn > 0) || !std::isfinite(gn)) return false;
   n = -g / gn;  // outward: L is positive inside
   return true;
 }
 
-bool BoundarySurface::reproject(Vec3& x, const Vec3& n, double len) const {
-  if (!field_) {
+bool BoundarySurface::reproject(Index v, Vec3& x, const Vec3& n, double len) const {
+  if (surfaces_.empty()) {
     x = project(x, &n);
     return true;
   }
+  if (target(v) < 0) return false;
   Vec3 p = x;
-  if (!field_->project(p, len, tol_)) return false;
+  if (!surfaces_[target(v)].project(p, len)) return false;
   x = p;
   return true;
 }
 
-double BoundarySurface::deviation(const Vec3& x) const {
-  if (field_) return field_->value_range() > 0 ? std::abs(field_->level(x)) / field_->value_range() : std::abs(field_->level(x));
-  return (project(x) - x).norm();
+double BoundarySurface::deviation(Index v, const Vec3& x) const {
+  if (surfaces_.empty()) return (project(x) - x).norm();
+  if (target(v) < 0) return 0;
+  const contour::LevelSet& s = surfaces_[target(v)];
+  return std::abs(s.level(x)) / s.scale();
 }
 
 void BoundarySurface::classify(const HexMesh& mesh, double feature_degrees, bool keep_triangles) {

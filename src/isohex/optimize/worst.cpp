@@ -61,7 +61,7 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySur
   const bool slides = surface && surface->role(v) == BoundarySurface::Role::slides;
   Vec3 n = Vec3::Zero();
   if (slides) {
-    if (!surface->tangent_normal(x0, n)) return false;
+    if (!surface->tangent_normal(v, x0, n)) return false;
     d -= n * n.dot(d);
   }
   // The best of the halving steps, not the first that gains: the first overshoots (the
@@ -71,7 +71,7 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySur
   Vec3 best_x = x0;
   for (int i = 0; i < 12; ++i, t *= 0.5) {
     Vec3 x = x0 + t * d;
-    if (slides && !surface->reproject(x, n, len)) continue;  // off the surface: refused
+    if (slides && !surface->reproject(v, x, n, len)) continue;  // off the surface: refused
     bool valid = false;
     int below = 0;
     // Raising the local minimum is not enough when it is negative: a valid neighbour must
