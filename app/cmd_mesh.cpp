@@ -6,6 +6,7 @@
 #include "mesh_stages.hpp"
 
 #include "isohex/contour/dual_contour.hpp"
+#include "isohex/contour/refine_boundary.hpp"
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
@@ -44,6 +45,8 @@ struct Args {
   /// unset: slide unless --no-smooth.
   std::optional<bool> slide;
   int surface_iterations = 30;
+  std::optional<double> refine_tolerance;  ///< --refine-boundary TOL
+  int refine_levels = 1;
   std::optional<double> feature_angle;
   int* threads = nullptr;
 };
@@ -181,6 +184,31 @@ void run(const Args& a) {
 
   std::vector<StageRow> rows;
   rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes));
+  nlohmann::json refinement;
+  if (a.refine_tolerance) {
+    if (terminal) fmt::print("  boundary refinement...\n"), std::fflush(stdout);
+    contour::BoundaryRefineOptions ro;
+    ro.chord_tolerance = *a.refine_tolerance;
+    ro.levels = a.refine_levels;
+    const contour::BoundaryRefineReport rr = contour::refine_boundary(region, out, ro);
+    fmt::print("boundary refinement: {} quads chord the surface deeper than {:.3g} h (deepest {:.3g} h), {} refined "
+               "within the templates' budget; {} levels, "
+               "{} -> {} hexes ({} vertices marked, {} by the templates); {} new boundary vertices projected ({} "
+               "failed); deepest chord now {:.3g} h, {} quads over; mean chord {:.3g} h -> {:.3g} h; {} quads more than h off "
+               "the surface left alone\n",
+               rr.coarse_quads, ro.chord_tolerance, rr.max_chord_before, rr.refined_quads, rr.levels, rr.hexes_before, rr.hexes_after,
+               rr.marked_vertices, rr.promoted_vertices, rr.projected_vertices, rr.projection_failures,
+               rr.max_chord_after, rr.coarse_quads_after, rr.mean_chord_before, rr.mean_chord_after,
+               rr.unreachable_quads);
+    refinement = {{"chord_tolerance", ro.chord_tolerance}, {"levels", rr.levels}, {"coarse_quads", rr.coarse_quads}, {"refined_quads", rr.refined_quads},
+                  {"coarse_quads_after", rr.coarse_quads_after}, {"unreachable_quads", rr.unreachable_quads}, {"max_chord_before", rr.max_chord_before},
+                  {"max_chord_after", rr.max_chord_after},
+                  {"mean_chord_before", rr.mean_chord_before}, {"mean_chord_after", rr.mean_chord_after}, {"hexes_before", rr.hexes_before},
+                  {"hexes_after", rr.hexes_after}, {"marked_vertices", rr.marked_vertices},
+                  {"promoted_vertices", rr.promoted_vertices}, {"projected_vertices", rr.projected_vertices},
+                  {"projection_failures", rr.projection_failures}};
+    rows.push_back(stage_row("boundary refinement", out.mesh, rr.seconds));
+  }
   auto t = Clock::now();
   // Scans have no sharp features: every crease of their quads is a fold.
   const double feature_angle = a.feature_angle.value_or(a.shape.empty() ? 180.0 : 30.0);
@@ -229,7 +257,7 @@ void run(const Args& a) {
   const double write_time = seconds_since(t);
 
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
-             out.mesh.num_hexes(), out.mesh.num_vertices(), r.surface_vertices, r.box_vertices, check.num_boundary_quads);
+             out.mesh.num_hexes(), out.mesh.num_vertices(), dist.checked, dist.box_vertices, check.num_boundary_quads);
   fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds ({} simple and {} relocated, "
              "topology kept; {} forced; {} filling {} zero-volume cavities); {} cells split\n",
              r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.relocated_points, r.forced_points,
@@ -323,6 +351,7 @@ void run(const Args& a) {
     j["surface_smoothing"] = sm;
     j["feature_angle_degrees"] = feature_angle;
     j["stages"] = stage_table_json(rows);
+    if (a.refine_tolerance) j["refinement"] = refinement;
     if (!a.no_pillow) j["pillowing"] = pillowing;
     if (!a.no_smooth) j["optimisation"] = optimisation;
     j["peak_memory_mib"] = peak;
@@ -364,6 +393,11 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--outer", a->outer, "Outer boundary of --region outside: sphere:CX,CY,CZ,R or box:X0,Y0,Z0,X1,Y1,Z1 "
                                        "(default the volume's box)");
   cmd->add_option("--min-component", a->min_component, "Drop connected parts with fewer hexes");
+  cmd->add_option("--refine-boundary", a->refine_tolerance,
+                  "Refine (by 3, conforming templates) the hexes under boundary quads that chord the isosurface "
+                  "deeper than TOL x cell size, new boundary vertices on the isosurface (e.g. 0.02)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--refine-levels", a->refine_levels, "Rounds of --refine-boundary (default 1)")->check(CLI::Range(1, 3));
   cmd->add_flag("--no-surface-smoothing", a->no_surface_smoothing,
                 "Skip the geometric-flow smoothing of the boundary quads (on by default; vertices stay on the isosurface)");
   cmd->add_option("--surface-iterations", a->surface_iterations, "Iterations of the surface smoothing (default 30)")

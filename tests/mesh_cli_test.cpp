@@ -131,3 +131,33 @@ TEST(MeshCli, HeadInASphereKeepsEverySurfaceVertexOnItsSurface) {
   EXPECT_LE(j["max_relative_distance"].get<double>(), 1e-6);
   EXPECT_GT(j["simple_points"].get<int>(), 0);  // the case does go through the flipped-cell path
 }
+
+// --refine-boundary: a stage of its own in the table, a `refinement` report, more hexes, the
+// same boundary topology, every boundary vertex still on the isosurface.
+TEST(MeshCli, BoundaryRefinementKeepsTheMeshValidAndOnTheSurface) {
+  const auto dir = scratch_dir();
+  const std::string shape = "'union(sphere(0,0,0,1), torus(0,0,0.6, 1.1, 0.35))'";
+  const std::string common = "mesh --shape " + shape + " --resolution 14 --no-surface-smoothing --no-pillow --no-smooth -o ";
+  std::string out;
+  ASSERT_EQ(run_cli(common + q(dir / "raw.vtu") + " --json " + q(dir / "raw.json"), &out), 0) << out;
+  ASSERT_EQ(run_cli(common + q(dir / "ref.vtu") + " --json " + q(dir / "ref.json") + " --refine-boundary 0.05", &out), 0)
+      << out;
+  EXPECT_NE(out.find("boundary refinement:"), std::string::npos) << out;
+  const auto raw = nlohmann::json::parse(io::read_file(dir / "raw.json"));
+  const auto ref = nlohmann::json::parse(io::read_file(dir / "ref.json"));
+  const auto& r = ref["refinement"];
+  EXPECT_GT(r["refined_quads"].get<int>(), 0);
+  EXPECT_EQ(r["hexes_before"], raw["hexes"]);
+  EXPECT_EQ(r["hexes_after"], ref["hexes"]);
+  EXPECT_GT(ref["hexes"].get<int>(), raw["hexes"].get<int>());
+  EXPECT_EQ(r["projection_failures"], 0);
+  EXPECT_LT(r["mean_chord_after"].get<double>(), r["mean_chord_before"].get<double>());
+  EXPECT_EQ(ref["stages"].size(), raw["stages"].size() + 1);
+  EXPECT_EQ(ref["boundary_components"], raw["boundary_components"]);
+  EXPECT_EQ(ref["euler_characteristic"], raw["euler_characteristic"]);
+  EXPECT_TRUE(ref["valid"].get<bool>());
+  EXPECT_EQ(ref["off_surface_vertices"], 0);
+  EXPECT_LE(ref["max_relative_distance"].get<double>(), 1e-6);
+  EXPECT_TRUE(validate(io::read_mesh(dir / "ref.vtu")).valid());
+  EXPECT_NE(run_cli("mesh --shape " + shape + " --resolution 8 --refine-boundary -1 -o " + q(dir / "bad.vtu"), &out), 0);
+}
