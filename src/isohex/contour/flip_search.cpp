@@ -1,8 +1,12 @@
-// The manifold repair's topology-preserving searches: sequences of simple flips (short,
-// prepared and deep; FlipSearch) and the phase that runs them over the non-manifold cells.
+// The manifold repair's simple flips: of the samples at L == 0 whose cells would put their
+// vertices on them (fill_zero_level_samples), and the searches for sequences of simple flips
+// (short, prepared and deep; FlipSearch) with the phase that runs them over the non-manifold cells.
 #include "isohex/contour/cell_cases.hpp"
 #include "isohex/contour/repair_internal.hpp"
 #include "isohex/contour/simple_point.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -212,6 +216,73 @@ std::size_t simple_phase(SampledGrid& g, RepairCounts& counts, Search mode, std:
     total += flips;
     if (flips == 0 || mode != Search::short_) return total;
   }
+}
+
+namespace {
+
+// True when every crossing of cell `cell` is at sample q. dual_contour.cpp finds a crossing on
+// each edge from an inside corner at L > 0 to an outside one at L <= 0, at that outside corner
+// when it is at L == 0; with all of them at q the cell's dual vertex goes onto q.
+bool pinned_to(const SampledGrid& g, std::size_t cell, std::size_t q) {
+  const std::uint8_t m = g.cell_mask_at(cell);
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  bool any = false;
+  for (int c = 0; c < 8; ++c) {
+    const std::size_t p = cell + (c & 1) + dy * (c >> 1 & 1) + dz * (c >> 2 & 1);
+    if (!(m >> c & 1) || !(g.level[p] > 0)) continue;
+    for (int a = 0; a < 3; ++a) {
+      const int d = c ^ (1 << a);
+      const std::size_t r = cell + (d & 1) + dy * (d >> 1 & 1) + dz * (d >> 2 & 1);
+      if ((m >> d & 1) || g.level[r] > 0) continue;  // no crossing on this edge
+      if (r != q) return false;
+      any = true;
+    }
+  }
+  return any;
+}
+
+// More than one cell around outside sample q at L == 0 has its dual vertex on q.
+bool shared_pin(const SampledGrid& g, std::size_t q) {
+  int n = 0;
+  for (std::size_t cell : cells_around(g, q)) n += pinned_to(g, cell, q);
+  return n > 1;
+}
+
+}  // namespace
+
+std::size_t fill_zero_level_samples(SampledGrid& g, RepairCounts& counts) {
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  std::vector<std::vector<std::size_t>> found(g.padded[2]);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(1, g.padded[2] - 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k != r.end(); ++k)
+      for (std::size_t p = dz * k + dy, end = dz * (k + 1) - dy; p < end; ++p)
+        if (!g.inside[p] && g.on_isosurface(p)) found[k].push_back(p);
+  });
+  std::vector<std::size_t> candidates;
+  for (const auto& slab : found) candidates.insert(candidates.end(), slab.begin(), slab.end());
+  if (candidates.empty()) return 0;
+  // Sequential, in grid order, in rounds (a fill can make a neighbour simple: the end of a
+  // chain of such samples first) until one fills nothing: the same for any thread count.
+  std::size_t total = 0;
+  for (std::size_t filled = 1; filled;) {
+    ++counts.rounds;
+    filled = 0;
+    for (std::size_t p : candidates) {
+      if (g.inside[p] || !shared_pin(g, p) || !simple_at(g, p)) continue;
+      const int before = non_manifold_around(g, p);
+      g.inside[p] = 1;
+      if (non_manifold_around(g, p) > before) {
+        g.inside[p] = 0;
+        continue;
+      }
+      counts.edits.push_back({p, RepairKind::zero_level});
+      ++filled;
+    }
+    total += filled;
+  }
+  counts.filled += total;
+  counts.zero_level += total;
+  return total;
 }
 
 }  // namespace isohex::contour

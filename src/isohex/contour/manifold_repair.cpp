@@ -238,6 +238,7 @@ std::size_t relocation_phase(SampledGrid& g, RepairCounts& counts, std::vector<s
 RepairCounts repair_manifold(SampledGrid& g) {
   RepairCounts counts;
   fill_degenerate_cavities(g, counts);
+  fill_zero_level_samples(g, counts);
   const std::size_t dz = g.padded[0] * g.padded[1];
   std::vector<std::size_t> cells = non_manifold_cells(g);
   simple_phase(g, counts, Search::short_, cells);
@@ -254,6 +255,9 @@ RepairCounts repair_manifold(SampledGrid& g) {
       break;
     simple_phase(g, counts, Search::short_, cells);
   }
+  const std::size_t before_zero = counts.edits.size();
+  fill_zero_level_samples(g, counts);
+  cells = still_non_manifold(g, std::move(cells), counts, before_zero);
   const std::size_t simple_carved = counts.carved, simple_filled = counts.filled;
   const std::size_t before_carving = counts.edits.size();
   counts.carved = repair_phase(g, 0, cells, counts, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {

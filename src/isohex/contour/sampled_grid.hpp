@@ -65,17 +65,19 @@ struct RepairCounts {
   std::size_t forced = 0;     ///< of those, edits that may change the topology
   std::size_t degenerate = 0;             ///< of the filled, points of zero-volume cavities
   std::size_t degenerate_components = 0;  ///< zero-volume cavities filled
+  std::size_t zero_level = 0;  ///< of the filled, samples at L == 0 on a real surface (fill_zero_level_samples)
   struct Edit {
     std::size_t point;  ///< padded index
     RepairKind kind;
   };
-  std::vector<Edit> edits;  ///< every flip, in the order made (degenerate ones first, forced ones last)
+  std::vector<Edit> edits;  ///< every flip, in the order made (degenerate, then zero_level ones first, forced ones last)
   std::size_t rounds = 0;
 };
 
 /// Makes the grid manifold, keeping the topology marching cubes gives the samples wherever it
 /// can. First (fill_degenerate_cavities) it fills the zero-volume cavities, which are not part
-/// of the solid's topology; then:
+/// of the solid's topology, and (fill_zero_level_samples) makes inside the samples at L == 0
+/// on which dual contouring would put several vertices, where that is a simple flip; then:
 ///  1. short sequences of simple flips (is_simple_6_18): for each non-manifold cell, the
 ///     shortest sequence of up to 5 simple flips, the first a corner of the cell and each next
 ///     one a corner of a non-manifold cell beside the flip before, that lowers the number of
@@ -117,6 +119,17 @@ RepairCounts repair_manifold(SampledGrid& g);
 /// hexes). Islands, the mirror case, cannot occur: inside points have L > 0. Sequential, in
 /// grid order. Adds the fills to `counts` (kind degenerate) and returns the cavities filled.
 std::size_t fill_degenerate_cavities(SampledGrid& g, RepairCounts& counts);
+
+/// Makes inside, in grid order and in rounds, each outside sample at L == 0 (on a real surface:
+/// the zero-volume cavities are filled before) that is a corner of a mixed cell whose outside
+/// corners are all at L == 0, where that flip is simple for marching cubes' (6, 18) topology,
+/// makes no cell non-manifold that was not and leaves every mixed cell around it an inside
+/// corner at L > 0. Such a cell's crossings are all at those grid points (its isosurface is
+/// there, for a trilinear field), so its dual vertex and those of the cells beside it would
+/// be put there: collapsed boundary quads and degenerate hexes. After the fill the cell is
+/// inside or its crossings are on edges of a true sign change. Adds the fills to `counts`
+/// (kind zero_level) and returns their number.
+std::size_t fill_zero_level_samples(SampledGrid& g, RepairCounts& counts);
 
 /// Labels the face-connected parts of the inside points (which are the connected parts of
 /// the hex mesh) and removes those with fewer than `min_points` points. Returns the numbers
