@@ -259,9 +259,9 @@ void run(const Args& a) {
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
              out.mesh.num_hexes(), out.mesh.num_vertices(), dist.checked, dist.box_vertices, check.num_boundary_quads);
   fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds ({} simple and {} relocated, "
-             "topology kept; {} forced; {} filling {} zero-volume cavities); {} cells split\n",
+             "topology kept; {} forced; {} filling {} zero-volume cavities; {} simple at the isovalue); {} cells split\n",
              r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.relocated_points, r.forced_points,
-             r.degenerate_points, r.degenerate_components, r.split_cells);
+             r.degenerate_points, r.degenerate_components, r.zero_level_points, r.split_cells);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -314,6 +314,7 @@ void run(const Args& a) {
     j["forced_points"] = r.forced_points;
     j["degenerate_components"] = r.degenerate_components;
     j["degenerate_points"] = r.degenerate_points;
+    j["zero_level_points"] = r.zero_level_points;
     // Every sample the repair flipped, so that the topology claims can be checked.
     nlohmann::json edits = nlohmann::json::array();
     for (const auto& e : r.edits) {
@@ -324,6 +325,7 @@ void run(const Args& a) {
                        {"kind", e.kind == contour::RepairKind::simple       ? "simple"
                                 : e.kind == contour::RepairKind::relocated  ? "relocated"
                                 : e.kind == contour::RepairKind::degenerate ? "degenerate"
+                                : e.kind == contour::RepairKind::zero_level ? "zero_level"
                                                                             : "forced"}});
     }
     j["repair_edits"] = edits;

@@ -398,14 +398,16 @@ TEST(ContourManifold, LargerZeroCavitiesAreFilledOnlyWithoutVolume) {
     EXPECT_EQ(m.result.report.degenerate_components, 0u);
     EXPECT_EQ(m.check.num_boundary_components, 2u);
   }
-  // A sample at the isovalue on the solid's outer surface is not a cavity: kept.
+  // A sample at the isovalue on the solid's outer surface is not a cavity; the 4 cells inward
+  // of it would put their vertices on it, so it is made inside (a simple flip, zero_level).
   {
     Volume v = block_with_cavities({});
     v.at(1, 3, 3) = 0.5f;
     const Meshed m = mesh_of(v);
     expect_closed_manifold(m);
     EXPECT_EQ(m.result.report.degenerate_components, 0u);
-    EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6 - 1);
+    EXPECT_EQ(m.result.report.zero_level_points, 1u);
+    EXPECT_EQ(m.result.mesh.num_hexes(), 6 * 6 * 6);
   }
 }
 
@@ -578,7 +580,7 @@ TEST(ContourManifold, RandomVolumesAlwaysGiveManifolds) {
     // Simple flips keep marching cubes' topology of the samples; with every flip applied the
     // mesh has that topology: one boundary per inside part and per cavity.
     const ExtractReport& r = m.result.report;
-    EXPECT_EQ(r.simple_points + r.relocated_points + r.forced_points + r.degenerate_points, r.edits.size());
+    EXPECT_EQ(r.simple_points + r.relocated_points + r.forced_points + r.degenerate_points + r.zero_level_points, r.edits.size());
     std::vector<std::uint8_t> before(v.values.size());
     for (std::size_t i = 0; i < before.size(); ++i) before[i] = v.values[i] > 0.5f;
     EXPECT_EQ(digital_topology(repaired_flags(v, r, true), n), digital_topology(before, n));

@@ -313,7 +313,7 @@ def main():
                             f"{len(got)} flipped, {len(expected)} in the field, {len(got ^ expected)} apart")
         mc_raw = marching_cubes(a, spacing, origin, iso, h, rng)
         mc = marching_cubes(a, spacing, origin, iso, h, rng, degenerate) if degenerate else mc_raw
-        simple = [e for e in edits if kind(e) in ("simple", "relocated")]
+        simple = [e for e in edits if kind(e) in ("simple", "relocated", "zero_level")]
         hb = hex_boundary(out)
         refined = "refinement" in report
         mc_vol = marching_cubes(a, spacing, origin, iso, h / 3, rng)["volume"] if refined else mc["volume"]
@@ -329,7 +329,7 @@ def main():
         print(f"{name}: {report['hexes']} hexes, SJ min {sj['min']:.3f} mean {sj['mean']:.3f} "
               f"<0 {sj['inverted']} <0.2 {sj['questionable']}; flips {len(report['repair_edits'])} "
               f"({report.get('relocated_points', 0)} relocated, {report['forced_points']} forced, "
-              f"{report.get('degenerate_points', 0)} degenerate); "
+              f"{report.get('degenerate_points', 0)} degenerate, {report.get('zero_level_points', 0)} zero-level); "
               f"volume {hb['volume']:.6g} vs MC {mc_vol:.6g} ({100 * dv:.3f} %); components {hb['components']} "
               f"vs {mc['components']}; Euler {hb['euler']} vs {mc['euler']}; max dist {report['max_relative_distance']:.2g}; "
               f"box vertices {report['box_vertices']}")
@@ -357,7 +357,7 @@ def main():
         if simple:
             mc_simple = marching_cubes(a, spacing, origin, iso, h, rng, degenerate + simple)
             if (mc_simple["components"], mc_simple["euler"]) != (mc["components"], mc["euler"]):
-                failures.append(f"{name}: the {len(simple)} simple and relocated flips change marching cubes' topology: components "
+                failures.append(f"{name}: the {len(simple)} simple, zero-level and relocated flips change marching cubes' topology: components "
                                 f"{mc_simple['components']} vs {mc['components']}, Euler {mc_simple['euler']} vs {mc['euler']}")
         if len(simple) + len(degenerate) != len(edits):
             mc_all = marching_cubes(a, spacing, origin, iso, h, rng, edits)

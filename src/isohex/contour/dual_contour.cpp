@@ -291,6 +291,7 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   rep.forced_points = repaired.forced;
   rep.degenerate_components = repaired.degenerate_components;
   rep.degenerate_points = repaired.degenerate;
+  rep.zero_level_points = repaired.zero_level;
   {
     // Each flip's new state, walking back from the final one (a point can flip more than once).
     std::vector<std::uint8_t> state(repaired.edits.size());

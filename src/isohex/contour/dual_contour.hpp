@@ -62,6 +62,8 @@ enum class RepairKind : std::uint8_t {
   forced,     ///< a forced carve or fill: may change the topology
   degenerate, ///< a fill of a zero-volume cavity (every sample at L == 0): removes a surface of zero
               ///< volume, and of zero area for fewer than 4 samples, which would give collapsed quads
+  zero_level, ///< a fill of a sample at L == 0 on a real surface on which dual contouring would put
+              ///< several vertices: a simple point, topology kept (fill_zero_level_samples)
 };
 
 /// Where a mesh vertex lies (ExtractResult::vertex_place); values ≥ 0 name a surface of the
@@ -88,15 +90,18 @@ struct ExtractReport {
   std::size_t forced_points = 0;       ///< of the filled and carved, edits that may change topology
   std::size_t degenerate_components = 0;  ///< zero-volume cavities filled (all samples at L == 0)
   std::size_t degenerate_points = 0;      ///< of the filled, their samples
+  std::size_t zero_level_points = 0;      ///< of the filled, samples at L == 0 made inside (simple; topology kept)
   /// Every flip of the repair in the order made: grid point (i, j, k), its state after the
-  /// flip (true = made inside), and its kind. Applied to the samples, the simple and relocated
-  /// ones keep marching cubes' topology and all of them give the mesh's topology; the
+  /// flip (true = made inside), and its kind. Applied to the samples, the simple, zero_level and
+  /// relocated ones keep marching cubes' topology and all of them give the mesh's topology; the
   /// degenerate ones (first) remove only surfaces of zero volume.
   struct Edit {
     std::array<Index, 3> point;
     bool inside;
     RepairKind kind;
-    [[nodiscard]] bool keeps_topology() const { return kind == RepairKind::simple || kind == RepairKind::relocated; }
+    [[nodiscard]] bool keeps_topology() const {
+      return kind == RepairKind::simple || kind == RepairKind::relocated || kind == RepairKind::zero_level;
+    }
   };
   std::vector<Edit> edits;
   std::size_t repair_rounds = 0;

@@ -1,15 +1,12 @@
 #pragma once
 /// \file handle_move.hpp
-/// \brief Internal to the manifold repair (sampled_grid.cpp): tunnel moves.
+/// \brief Internal to the manifold repair (manifold_repair.cpp): tunnel moves.
 
-#include "isohex/contour/sampled_grid.hpp"
+#include "isohex/contour/repair_internal.hpp"
 
 #include <cstddef>
 
 namespace isohex::contour {
-
-/// Not padding, and some 26-neighbour was sampled on the other side (sampled_grid.cpp).
-bool near_surface(const SampledGrid& g, std::size_t p);
 
 /// A tunnel move for non-manifold `cell`: a corner x of the cell whose flip changes the genus
 /// by one (closes or makes a tunnel or handle: topological numbers {1, 2} or {2, 1}, the two

@@ -65,17 +65,20 @@ struct RepairCounts {
   std::size_t forced = 0;     ///< of those, edits that may change the topology
   std::size_t degenerate = 0;             ///< of the filled, points of zero-volume cavities
   std::size_t degenerate_components = 0;  ///< zero-volume cavities filled
+  std::size_t zero_level = 0;  ///< of the filled, samples at L == 0 on a real surface (fill_zero_level_samples)
   struct Edit {
     std::size_t point;  ///< padded index
     RepairKind kind;
   };
-  std::vector<Edit> edits;  ///< every flip, in the order made (degenerate ones first, forced ones last)
+  std::vector<Edit> edits;  ///< every flip, in the order made (degenerate, then zero_level ones first, forced ones last)
   std::size_t rounds = 0;
 };
 
 /// Makes the grid manifold, keeping the topology marching cubes gives the samples wherever it
 /// can. First (fill_degenerate_cavities) it fills the zero-volume cavities, which are not part
-/// of the solid's topology; then:
+/// of the solid's topology, and (fill_zero_level_samples) makes inside the samples at L == 0
+/// on which dual contouring would put several vertices, where that is a simple flip (again
+/// after step 2); then:
 ///  1. short sequences of simple flips (is_simple_6_18): for each non-manifold cell, the
 ///     shortest sequence of up to 5 simple flips, the first a corner of the cell and each next
 ///     one a corner of a non-manifold cell beside the flip before, that lowers the number of
@@ -117,6 +120,18 @@ RepairCounts repair_manifold(SampledGrid& g);
 /// hexes). Islands, the mirror case, cannot occur: inside points have L > 0. Sequential, in
 /// grid order. Adds the fills to `counts` (kind degenerate) and returns the cavities filled.
 std::size_t fill_degenerate_cavities(SampledGrid& g, RepairCounts& counts);
+
+/// Makes inside, in grid order and in rounds until none is left, each outside sample at L == 0
+/// (on a real surface: the zero-volume cavities are filled before) on which more than one cell
+/// has all its crossings, where that flip is simple for marching cubes' (6, 18) topology and
+/// makes no cell non-manifold. dual_contour.cpp puts a crossing at the outside end of an edge
+/// when that end is at L == 0, so such cells' dual vertices all go onto that one grid point
+/// (for a trilinear field their isosurface is that point): collapsed boundary quads and
+/// degenerate hexes that no smoothing can mend. Inside, the sample is a corner of their hexes
+/// instead. Run before and after the topology-preserving repair (whose flips beside such a
+/// sample can make it shared). Adds the fills to `counts` (kind zero_level) and returns their
+/// number.
+std::size_t fill_zero_level_samples(SampledGrid& g, RepairCounts& counts);
 
 /// Labels the face-connected parts of the inside points (which are the connected parts of
 /// the hex mesh) and removes those with fewer than `min_points` points. Returns the numbers

@@ -1,0 +1,41 @@
+#pragma once
+/// \file repair_internal.hpp
+/// \brief Internal to the manifold repair (manifold_repair.cpp, flip_search.cpp,
+/// handle_move.cpp): the helpers they share.
+
+#include "isohex/contour/sampled_grid.hpp"
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace isohex::contour {
+
+/// The 8 cells around padded point p (never padding), by the index of their lowest corner.
+inline std::array<std::size_t, 8> cells_around(const SampledGrid& g, std::size_t p) {
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  std::array<std::size_t, 8> cells{};
+  for (int c = 0; c < 8; ++c) cells[static_cast<std::size_t>(c)] = p - (c & 1) - dy * (c >> 1 & 1) - dz * (c >> 2 & 1);
+  return cells;
+}
+
+/// Not padding, and next to the isosurface: some 26-neighbour was sampled on the other side
+/// (flip_search.cpp).
+bool near_surface(const SampledGrid& g, std::size_t p);
+
+/// The non-manifold cells among `cells` and among the cells around the points flipped since
+/// edit `from`, in grid order: all there are, if `cells` were all before those flips
+/// (manifold_repair.cpp).
+std::vector<std::size_t> still_non_manifold(const SampledGrid& g, std::vector<std::size_t> cells,
+                                            const RepairCounts& counts, std::size_t from);
+
+/// The topology-preserving phase (flip_search.cpp): each non-manifold cell in turn (`cells`,
+/// all there are, in grid order) gets the best sequence of simple flips (for marching cubes'
+/// (6, 18) topology) that lowers the number of non-manifold cells: short sequences in rounds
+/// until one flips nothing, or one round of prepared sequences or of the deep search. That
+/// number falls with every sequence, so this ends; sequential, in cell order, so it is
+/// deterministic. Updates `cells` to the non-manifold cells left and returns the number of flips.
+enum class Search { short_, prepared, deep };
+std::size_t simple_phase(SampledGrid& g, RepairCounts& counts, Search mode, std::vector<std::size_t>& cells);
+
+}  // namespace isohex::contour
