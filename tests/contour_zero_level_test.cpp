@@ -55,29 +55,27 @@ Meshed mesh_of(const Volume& v, RegionSpec spec = half()) {
 // vertices pinned to a sample at the isovalue land on it within ~1e-5, not always exactly).
 constexpr double kCoincident = 1e-3;
 
+// Whether two of the cell's corners coincide (to kCoincident).
+template <std::size_t N>
+bool has_coincident_corners(const HexMesh& mesh, const std::array<Index, N>& cell) {
+  for (std::size_t a = 0; a < N; ++a)
+    for (std::size_t b = a + 1; b < N; ++b)
+      if ((mesh.points[static_cast<std::size_t>(cell[a])] - mesh.points[static_cast<std::size_t>(cell[b])]).norm() < kCoincident)
+        return true;
+  return false;
+}
+
 // Boundary quads with two coincident corners (collapsed or partly collapsed).
 std::size_t quads_with_coincident_corners(const HexMesh& mesh) {
   std::size_t n = 0;
-  for (const Quad& q : boundary_quads(mesh)) {
-    bool coincide = false;
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b)
-        coincide = coincide || (mesh.points[static_cast<std::size_t>(q[a])] - mesh.points[static_cast<std::size_t>(q[b])]).norm() < kCoincident;
-    n += coincide;
-  }
+  for (const Quad& q : boundary_quads(mesh)) n += has_coincident_corners(mesh, q);
   return n;
 }
 
 // Hexes with two coincident corners (degenerate or nearly).
 std::size_t hexes_with_coincident_corners(const HexMesh& mesh) {
   std::size_t n = 0;
-  for (const auto& hex : mesh.hexes) {
-    bool coincide = false;
-    for (int a = 0; a < 8; ++a)
-      for (int b = a + 1; b < 8; ++b)
-        coincide = coincide || (mesh.points[static_cast<std::size_t>(hex[a])] - mesh.points[static_cast<std::size_t>(hex[b])]).norm() < kCoincident;
-    n += coincide;
-  }
+  for (const Hex& hex : mesh.hexes) n += has_coincident_corners(mesh, hex);
   return n;
 }
 

@@ -251,15 +251,7 @@ bool shared_pin(const SampledGrid& g, std::size_t q) {
 }  // namespace
 
 std::size_t fill_zero_level_samples(SampledGrid& g, RepairCounts& counts) {
-  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
-  std::vector<std::vector<std::size_t>> found(g.padded[2]);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(1, g.padded[2] - 1), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k != r.end(); ++k)
-      for (std::size_t p = dz * k + dy, end = dz * (k + 1) - dy; p < end; ++p)
-        if (!g.inside[p] && g.on_isosurface(p)) found[k].push_back(p);
-  });
-  std::vector<std::size_t> candidates;
-  for (const auto& slab : found) candidates.insert(candidates.end(), slab.begin(), slab.end());
+  const std::vector<std::size_t> candidates = zero_level_outside(g);
   if (candidates.empty()) return 0;
   // Sequential, in grid order, in rounds (a fill can make a neighbour simple: the end of a
   // chain of such samples first) until one fills nothing: the same for any thread count.

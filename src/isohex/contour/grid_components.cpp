@@ -1,5 +1,6 @@
 // Edits of the grid by connected parts: the fill of zero-volume cavities (before the manifold
 // repair) and the removal of small components (after it).
+#include "isohex/contour/repair_internal.hpp"
 #include "isohex/contour/sampled_grid.hpp"
 
 #include <tbb/blocked_range.h>
@@ -9,17 +10,22 @@
 
 namespace isohex::contour {
 
-std::size_t fill_degenerate_cavities(SampledGrid& g, RepairCounts& counts) {
+std::vector<std::size_t> zero_level_outside(const SampledGrid& g) {
   const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
-  // Candidates: outside samples at L == 0 exactly, gathered per slab in parallel, in grid order.
   std::vector<std::vector<std::size_t>> found(g.padded[2]);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(1, g.padded[2] - 1), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t k = r.begin(); k != r.end(); ++k)
       for (std::size_t p = dz * k + dy, end = dz * (k + 1) - dy; p < end; ++p)
         if (!g.inside[p] && g.on_isosurface(p)) found[k].push_back(p);
   });
-  std::vector<std::size_t> seeds;
-  for (const auto& slab : found) seeds.insert(seeds.end(), slab.begin(), slab.end());
+  std::vector<std::size_t> all;
+  for (const auto& slab : found) all.insert(all.end(), slab.begin(), slab.end());
+  return all;
+}
+
+std::size_t fill_degenerate_cavities(SampledGrid& g, RepairCounts& counts) {
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  const std::vector<std::size_t> seeds = zero_level_outside(g);
   if (seeds.empty()) return 0;
   // The 18-neighbourhood: offsets with one or two nonzero coordinates.
   std::vector<std::ptrdiff_t> nb;

@@ -23,6 +23,10 @@ inline std::array<std::size_t, 8> cells_around(const SampledGrid& g, std::size_t
 /// (flip_search.cpp).
 bool near_surface(const SampledGrid& g, std::size_t p);
 
+/// The outside samples exactly at L == 0 (SampledGrid::on_isosurface), in grid order; found per
+/// z-slab in parallel. The candidates of both fills of samples at the isovalue.
+std::vector<std::size_t> zero_level_outside(const SampledGrid& g);
+
 /// The non-manifold cells among `cells` and among the cells around the points flipped since
 /// edit `from`, in grid order: all there are, if `cells` were all before those flips
 /// (manifold_repair.cpp).
