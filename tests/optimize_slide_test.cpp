@@ -213,7 +213,7 @@ HexMesh distorted_iso_ball(const IsoField& field) {
   return m;
 }
 
-Outcome optimise_iso(const HexMesh& in, const IsoField* field, int threads) {
+Outcome optimise_iso(const HexMesh& in, const IsoField* field, int threads, bool worst = true) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   Outcome r{in};
   std::unique_ptr<BoundarySurface> surface;
@@ -221,6 +221,7 @@ Outcome optimise_iso(const HexMesh& in, const IsoField* field, int threads) {
   const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(in, FixedVertices::boundary);
   OptimizeOptions o;
   o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
+  o.worst = worst;
   optimize_mesh(r.mesh, fixed, o);
   r.objective = shape_objective(r.mesh);
   r.min_sj = 1;
@@ -255,7 +256,9 @@ TEST(OptimizeSlide, IsosurfaceSlidingStaysOnTheSampledSphere) {
   }
   EXPECT_GT(moved, 50u);
   EXPECT_GT(slide.min_sj, fixed.min_sj);
-  EXPECT_LT(slide.objective, fixed.objective);
+  // The shape objective is compared before the worst pass, which trades some of it for the
+  // minimum (here min 0.10 -> 0.28, mean inverse mean ratio 1.28 -> 1.80).
+  EXPECT_LT(optimise_iso(in, &field, 2, false).objective, optimise_iso(in, nullptr, 2, false).objective);
   // The same bits with one thread.
   const Outcome one = optimise_iso(in, &field, 1);
   EXPECT_EQ(one.mesh.points, slide.mesh.points);

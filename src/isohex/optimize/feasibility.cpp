@@ -76,6 +76,11 @@ MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w
   return out;
 }
 
+Vec3 det_gradient(const Mat3& A, const Vec3& c) {
+  // adj(A)ᵀ c, written with the cross products of A's columns.
+  return c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) + c[2] * A.col(0).cross(A.col(1));
+}
+
 std::vector<Affine> vertex_frames(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                                   const std::vector<std::uint8_t>* fixed, const std::vector<std::uint8_t>* skip,
                                   std::vector<Index>* hex_of) {
@@ -100,8 +105,7 @@ std::vector<Affine> vertex_frames(const HexMesh& mesh, const Incidence& inc, con
       const Mat3 A = frame(p, t, il);
       Affine a;
       a.b = A.determinant();
-      // d det(A + il·d cᵀ)/dd = il·adj(A)ᵀ c, written with the cross products of A's columns.
-      a.a = il * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) + c[2] * A.col(0).cross(A.col(1)));
+      a.a = il * det_gradient(A, c);
       out.push_back(a);
       if (hex_of) hex_of->push_back(h);
     }

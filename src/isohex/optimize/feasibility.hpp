@@ -11,6 +11,7 @@
 
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 
 #include <vector>
@@ -33,6 +34,10 @@ struct MaxMin {
 /// Maximises the smallest f_i(d)/w_i over the cube |d_j| <= box (w_i > 0). A dense simplex
 /// with Bland's rule: exact arithmetic order, so the same bits on every run.
 MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w, double box);
+
+/// d det(A + d cᵀ)/dd: the gradient of a frame's determinant when one of its corners moves by d
+/// and c is that corner's coefficient in the frame (frame_coefficient()).
+Vec3 det_gradient(const Mat3& A, const Vec3& c);
 
 /// The normalised determinants of the frames that see vertex v (each incident hex, the corner
 /// frames using v and the centre frame) as affine functions of v's displacement. With `fixed`,

@@ -34,8 +34,9 @@
 ///   corner frames of each valid hex (ideal: the unit cube corner). A move must keep all 9
 ///   determinants of every incident hex positive, so no valid hex is ever inverted, and it
 ///   must lower the objective, so the objective never increases.
-/// - improve_worst(): local max–min moves on the vertices of the worst hexes, accepted only if
-///   the minimum scaled Jacobian (Verdict's) of the hexes around the vertex rises.
+/// - improve_worst(): local max–min moves on the vertices of the worst hexes (an LP on the
+///   linearised frame values of Verdict's scaled Jacobian), accepted only if the smallest of
+///   the values the vertex changes rises and Verdict's minimum around the vertex does not fall.
 ///
 /// With a BoundarySurface (slide.hpp) in the options, its sliding boundary vertices move too:
 /// tangential steps, put back on the input's boundary surface or on an IsoField's isosurface
@@ -187,6 +188,15 @@ struct WorstOptions {
   std::size_t count = 100;  ///< ... at most this many of the worst,
   double raise_below = 0.3; ///< ... and on those of every hex below this (the questionable ones and a margin)
   int passes = 30;
+  /// A move of a vertex: the max–min LP step within a box of half-side `step` × its mean edge
+  /// length, halved up to `trials` times until the true values gain, the model rebuilt up to
+  /// `models` times at the new place.
+  double step = 0.25;
+  int trials = 10;
+  int models = 4;
+  double target = 0.6;  ///< a vertex whose frame values are all at least this is not moved
+  /// No move may make an edge shorter than this fraction of its length when the pass began.
+  double min_edge_shrink = 0.5;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };

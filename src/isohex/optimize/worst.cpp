@@ -1,12 +1,14 @@
 // Worst-element pass: local max–min moves on Verdict's scaled Jacobian itself.
 #include "isohex/mesh/topology.hpp"
 #include "isohex/optimize/feasibility.hpp"
+#include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/summary.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace isohex {
@@ -20,9 +22,12 @@ double sj_value(const std::array<Vec3, 8>& p) {
 }
 
 // The lowest scaled Jacobian of the hexes around v with v placed at x. With `valid`, also
-// whether every hex that is valid now (scaled Jacobian > 0) stays valid there.
+// whether every hex that is valid now (scaled Jacobian > 0) stays valid there and no edge at
+// v is shorter than `shrink` times its length in `start` (the mesh when the pass began): the
+// scaled Jacobian is blind to edge lengths, so a max–min ascent alone may shrink an edge
+// towards zero (on a sphere's mesh it drove the mean inverse mean ratio from 1.3 to 81).
 double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool* valid = nullptr,
-                 int* questionable = nullptr) {
+                 int* questionable = nullptr, const std::vector<Vec3>* start = nullptr, double shrink = 0) {
   double lo = 2.0;
   if (valid) *valid = true;
   if (questionable) *questionable = 0;
@@ -34,58 +39,118 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
     const double q = sj_value(p);
     lo = std::min(lo, q);
     if (questionable) *questionable += q < kQuestionableSJ;
-    if (valid && q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
+    if (!valid) continue;
+    if (q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
+    for (const auto& e : kHexEdges) {
+      const Index a = mesh.hexes[h][e[0]], b = mesh.hexes[h][e[1]];
+      if (start && (a == v || b == v) &&
+          (p[e[0]] - p[e[1]]).squaredNorm() < shrink * shrink * ((*start)[a] - (*start)[b]).squaredNorm())
+        *valid = false;
+    }
   }
   return lo;
 }
 
-// One max–min move of v: a finite-difference ascent direction of the local minimum, then
-// shrinking steps; the first that raises the local minimum (inverting nothing) is taken.
-bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const BoundarySurface* surface) {
+// The scaled Jacobians of the frames (of the hexes around v) that v's position changes, each
+// as its value and gradient in that position: det[a b c] / (|a| |b| |c|), the columns of
+// opt::frame(). Verdict's hex value is the minimum of these and of the frames v is not in.
+// With `value_only`, the gradients are left zero.
+std::vector<opt::Affine> frame_values(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x,
+                                      bool value_only = false) {
+  std::vector<opt::Affine> out;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const Index h = inc.ids[i];
+    auto p = mesh.corners(h);
+    int k = 0;
+    while (mesh.hexes[h][k] != v) ++k;
+    p[k] = x;
+    for (int t = 0; t < opt::kFrames; ++t) {
+      const Vec3& c = opt::frame_coefficient(t, k);
+      if (c.isZero()) continue;
+      const opt::Mat3 A = opt::frame(p, t, 1.0);
+      const Vec3 l(A.col(0).norm(), A.col(1).norm(), A.col(2).norm());
+      const double prod = l.prod();
+      opt::Affine f;
+      if (!(prod > 0)) {  // a collapsed edge: as Verdict's degenerate hex, below everything
+        f.b = -2.0;
+        out.push_back(f);
+        continue;
+      }
+      f.b = A.determinant() / prod;
+      if (!value_only) {
+        // Column j moves by c_j d: d det = adj(A)ᵀc · d, and each |col j| by c_j col_j·d / |col j|.
+        f.a = opt::det_gradient(A, c) / prod;
+        for (int j = 0; j < 3; ++j) f.a -= f.b * c[j] / (l[j] * l[j]) * A.col(j);
+      }
+      out.push_back(f);
+    }
+  }
+  return out;
+}
+
+double lowest(const std::vector<opt::Affine>& f) {
+  double lo = 2.0;
+  for (const opt::Affine& a : f) lo = std::min(lo, a.b);
+  return lo;
+}
+
+// A max–min move of v: at its current place, the frame values v changes are linearised and
+// the LP max_min_affine() finds the step within a trust box that maximises their smallest
+// (a first-order model of a nonsmooth max–min, which a single gradient misses where two
+// frames tie: following either one lowers the other). The box halves until the true values
+// confirm a gain, and the model is rebuilt at the new place a few times. A step is taken only
+// if the smallest of those frame values rises, Verdict's minimum around v does not fall, no
+// valid hex is inverted and no more hexes around v fall below 0.2; so the mesh minimum never
+// falls. A sliding vertex steps in its tangent plane and is put back on its surface.
+bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector<Vec3>& start,
+                 const BoundarySurface* surface, const WorstOptions& options) {
   const Vec3 x0 = mesh.points[v];
   int below0 = 0;
   const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0);
   const double len = opt::mean_edge_at(mesh, inc, v);
   if (!(len > 0)) return false;
-  const double h = 1e-5 * len;
-  Vec3 g;
-  for (int j = 0; j < 3; ++j) {
-    Vec3 a = x0, b = x0;
-    a[j] += h;
-    b[j] -= h;
-    g[j] = (local_min(mesh, inc, v, a) - local_min(mesh, inc, v, b)) / (2 * h);
-  }
-  if (!(g.norm() > 0)) return false;
-  Vec3 d = g.normalized() * len;
-  // A sliding boundary vertex: tangential steps, put back on the target surface.
   const bool slides = surface && surface->role(v) == BoundarySurface::Role::slides;
-  Vec3 n = Vec3::Zero();
-  if (slides) {
-    if (!surface->tangent_normal(v, x0, n)) return false;
-    d -= n * n.dot(d);
-  }
-  // The best of the halving steps, not the first that gains: the first overshoots (the
-  // minimum rises a hair while the other hexes around v are bent down to it), which cost the
-  // ball of generate.hpp 10 % of its mean inverse mean ratio for no gain in the minimum.
-  double t = 0.2, best = m0;
-  Vec3 best_x = x0;
-  for (int i = 0; i < 12; ++i, t *= 0.5) {
-    Vec3 x = x0 + t * d;
-    if (slides && !surface->reproject(v, x, n, len)) continue;  // off the surface: refused
-    bool valid = false;
-    int below = 0;
-    // Raising the local minimum is not enough when it is negative: a valid neighbour must
-    // not be inverted on the way (it could still sit above that negative minimum). Nor may
-    // more hexes around v fall below 0.2: raising one by bending its neighbours down to it
-    // would trade one questionable hex for several.
-    const double q = local_min(mesh, inc, v, x, &valid, &below);
-    if (valid && below <= below0 && q > best) {
-      best = q;
-      best_x = x;
+  Vec3 x = x0;
+  double box = options.step * len;
+  bool moved = false;
+  for (int model = 0; model < options.models; ++model) {
+    std::vector<opt::Affine> f = frame_values(mesh, inc, v, x);
+    const double now = lowest(f);
+    // Frames at the target are good enough: no move there, and the model seeks no more (a
+    // constant frame at the target caps the LP's bound), so the max–min step does not flatten
+    // the shape of hexes that need no help.
+    if (!(now < options.target)) break;
+    // Tangential steps of a sliding vertex: the LP's unknowns are coordinates in the tangent
+    // plane (the third has no effect and stays in the box).
+    Vec3 n = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
+    if (slides) {
+      if (!surface->tangent_normal(v, x, n)) break;
+      t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+      t2 = n.cross(t1);
+      for (opt::Affine& a : f) a.a = Vec3(a.a.dot(t1), a.a.dot(t2), 0.0);
     }
+    f.push_back({Vec3::Zero(), options.target});
+    const std::vector<double> w(f.size(), 1.0);
+    bool gained = false;
+    for (int trial = 0; trial < options.trials && !gained; ++trial, box *= 0.5) {
+      const opt::MaxMin r = opt::max_min_affine(f, w, box);
+      if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model: a max–min point
+      Vec3 y = slides ? Vec3(x + r.d[0] * t1 + r.d[1] * t2) : Vec3(x + r.d);
+      if (slides && !surface->reproject(v, y, n, len)) continue;  // off the surface: refused
+      bool valid = false;
+      int below = 0;
+      // A negative local minimum may rise while a valid neighbour is inverted on the way;
+      // raising one hex by bending several others below 0.2 is no gain.
+      const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink);
+      if (!valid || below > below0 || q < m0 || !(lowest(frame_values(mesh, inc, v, y, true)) > now + 1e-9)) continue;
+      x = y;
+      gained = moved = true;
+    }
+    if (!gained) break;
+    box = std::min(4 * box, options.step * len);  // the box that worked, doubled (the loop halved it once more)
   }
-  if (!(best > m0 + 1e-9)) return false;
-  mesh.points[v] = best_x;
+  if (!moved) return false;
+  mesh.points[v] = x;
   return true;
 }
 
@@ -100,6 +165,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   res.min_sj_before = res.min_sj_after = mesh_min();
   std::vector<Index> order(mesh.hexes.size());
   std::vector<Index> seen(mesh.points.size(), -1);
+  const std::vector<Vec3> start = mesh.points;
   for (int pass = 1; pass <= options.passes; ++pass) {
     // Sequential and in a fixed order (worst first, ties by id): deterministic, and cheap
     // since only a few hundred vertices take part.
@@ -112,7 +178,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       for (Index v : mesh.hexes[order[i]]) {
         if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
         seen[v] = pass;
-        if (!move_vertex(mesh, inc, v, options.surface)) continue;
+        if (!move_vertex(mesh, inc, v, start, options.surface, options)) continue;
         ++moved;
         for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) sj[inc.ids[k]] = sj_value(mesh.corners(inc.ids[k]));
       }
