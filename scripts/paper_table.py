@@ -114,8 +114,16 @@ def main():
               f"and surface smoothing (the paper's geometric-flow mesh), 'after' after boundary pillowing, untangling "
               f"and mean-ratio optimisation (the boundary sliding on its surfaces, or fixed where the row says). The paper's figures are from its figures 9-15 "
               f"(LBIE-Mesher's adaptive meshes of other scans, optimised with Mesquite).\n\n")
+    # The commentary after the table is written by hand: keep what the old file has there.
+    commentary = ""
+    if os.path.exists(args.out):
+        old = open(args.out).read().split("\n")
+        rows = [i for i, l in enumerate(old) if l.startswith("|")]
+        if rows:
+            commentary = "\n".join(old[rows[-1] + 1:]).rstrip("\n")
     with open(args.out, "w") as f:
-        f.write("# The paper's table, reproduced\n\n" + header + "\n".join(lines) + "\n")
+        f.write("# The paper's table, reproduced\n\n" + header + "\n".join(lines) + "\n" +
+                (commentary + "\n" if commentary else ""))
     print(f"written: {args.out}")
 
 
