@@ -213,14 +213,12 @@ HexMesh distorted_iso_ball(const IsoField& field) {
   return m;
 }
 
-Outcome optimise_iso(const HexMesh& in, const IsoField* field, int threads, bool worst = true) {
-  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  Outcome r{in};
-  std::unique_ptr<BoundarySurface> surface;
-  if (field) surface = std::make_unique<BoundarySurface>(in, *field);
-  const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(in, FixedVertices::boundary);
+// Optimises r.mesh (boundary sliding on `surface`, or fixed without one) and records the
+// objective, the minimum scaled Jacobian (degenerate counts as -1) and the inverted hexes.
+void optimise_into(Outcome& r, const BoundarySurface* surface, bool worst) {
+  const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(r.mesh, FixedVertices::boundary);
   OptimizeOptions o;
-  o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
+  o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface;
   o.worst = worst;
   optimize_mesh(r.mesh, fixed, o);
   r.objective = shape_objective(r.mesh);
@@ -229,6 +227,14 @@ Outcome optimise_iso(const HexMesh& in, const IsoField* field, int threads, bool
     r.min_sj = std::min(r.min_sj, is_degenerate(q) ? -1.0 : q);
     r.inverted += q <= 0 || is_degenerate(q);
   }
+}
+
+Outcome optimise_iso(const HexMesh& in, const IsoField* field, int threads, bool worst = true) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+  Outcome r{in};
+  std::unique_ptr<BoundarySurface> surface;
+  if (field) surface = std::make_unique<BoundarySurface>(in, *field);
+  optimise_into(r, surface.get(), worst);
   return r;
 }
 
@@ -369,16 +375,7 @@ struct TwoSurfaces {
     Outcome r{raw.mesh};
     std::unique_ptr<BoundarySurface> surface;
     if (slide) surface = std::make_unique<BoundarySurface>(raw.mesh, region.surfaces, raw.vertex_place);
-    const auto fixed = surface ? surface->fixed_mask() : fixed_mask(raw.mesh, FixedVertices::boundary);
-    OptimizeOptions o;
-    o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
-    optimize_mesh(r.mesh, fixed, o);
-    r.objective = shape_objective(r.mesh);
-    r.min_sj = 1;
-    for (double q : scaled_jacobians(r.mesh)) {
-      r.min_sj = std::min(r.min_sj, is_degenerate(q) ? -1.0 : q);
-      r.inverted += q <= 0 || is_degenerate(q);
-    }
+    optimise_into(r, surface.get(), true);
     return r;
   }
 };
