@@ -45,8 +45,7 @@ void run(const Args& a) {
 
   fmt::print("{}: {} hexes, {} vertices; selection '{}': {} hexes\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
              a.hexes, ids.size());
-  fmt::print("marked vertices: {}; promoted: {} (in {} sweeps)\n", r.marked_vertices, r.promoted_vertices,
-             r.promotion_sweeps);
+  fmt::print("marked vertices: {}; promoted: {}\n", r.marked_vertices, r.promoted_vertices);
   fmt::print("templates (parent hexes -> new hexes):\n");
   for (int t = 0; t < kNumRefineTemplates; ++t)
     fmt::print("  {:<10} {:>8} -> {:>8}\n", refine_template_name(static_cast<RefineTemplate>(t)), r.parents[t],
@@ -63,7 +62,6 @@ void run(const Args& a) {
     j["selected_hexes"] = ids.size();
     j["marked_vertices"] = r.marked_vertices;
     j["promoted_vertices"] = r.promoted_vertices;
-    j["promotion_sweeps"] = r.promotion_sweeps;
     for (int t = 0; t < kNumRefineTemplates; ++t) {
       const char* name = refine_template_name(static_cast<RefineTemplate>(t));
       j["templates"][name] = {{"parents", r.parents[t]}, {"hexes", r.children[t]}};

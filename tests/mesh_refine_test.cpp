@@ -388,3 +388,24 @@ TEST(RefineCli, RegionIdsAndErrors) {
   EXPECT_FALSE(std::filesystem::exists(dir / "x.vtu"));
   EXPECT_EQ(run_cli("refine --help", &out), 0);
 }
+
+// close_marks: the same least fixpoint as refine()'s promotion; over its limit it leaves the
+// marks as they were, seeds aside.
+TEST(Refine, CloseMarksRespectsItsLimit) {
+  const HexMesh m = box_mesh(3, 3, 3);
+  const Incidence around = vertex_hexes(m);
+  // Two diagonal corners of the middle hex: no template, so its 8 corners are marked, and
+  // from there its neighbours' too.
+  const Hex& mid = m.hexes[13];
+  std::vector<std::uint8_t> marks(m.points.size(), 0);
+  marks[mid[0]] = marks[mid[6]] = 1;
+  std::vector<std::uint8_t> limited = marks;
+  EXPECT_EQ(close_marks(m, around, limited, {mid[0], mid[6]}, 3), 4u);
+  EXPECT_EQ(limited, marks);
+  std::vector<std::uint8_t> closed = marks;
+  const std::size_t added = close_marks(m, around, closed, {mid[0], mid[6]});
+  EXPECT_GE(added, 6u);
+  const RefineResult r = refine(m, marks);
+  EXPECT_EQ(r.marked, closed);
+  EXPECT_EQ(r.promoted_vertices, added);
+}

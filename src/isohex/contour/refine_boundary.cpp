@@ -72,33 +72,15 @@ std::vector<std::uint8_t> mark_within_budget(const HexMesh& mesh, const ChordSca
                                              std::size_t& accepted, std::size_t& promoted) {
   std::vector<std::uint8_t> marked(mesh.points.size(), 0);
   const Incidence around = vertex_hexes(mesh);
-  std::vector<Index> added, queue;
+  std::vector<Index> seeds;
   for (const auto& [chord, quad] : scan.coarse) {
-    added.clear();
-    queue.clear();
+    seeds.clear();
     for (Index v : quad)
-      if (!marked[static_cast<std::size_t>(v)]) marked[static_cast<std::size_t>(v)] = 1, added.push_back(v), queue.push_back(v);
-    std::size_t extra = 0;
-    bool over = false;
-    while (!queue.empty() && !over) {
-      const Index v = queue.back();
-      queue.pop_back();
-      for (Index k = around.offsets[v]; k < around.offsets[v + 1] && !over; ++k) {
-        const Hex& hx = mesh.hexes[static_cast<std::size_t>(around.ids[static_cast<std::size_t>(k)])];
-        std::uint8_t m = 0;
-        for (int c = 0; c < 8; ++c) m |= static_cast<std::uint8_t>(marked[static_cast<std::size_t>(hx[c])] << c);
-        const std::uint8_t p = promoted_mask(m);
-        for (int c = 0; c < 8 && !over; ++c) {
-          if (!(p >> c & 1) || (m >> c & 1)) continue;
-          marked[static_cast<std::size_t>(hx[c])] = 1;
-          added.push_back(hx[c]);
-          queue.push_back(hx[c]);
-          over = ++extra > budget;
-        }
-      }
-    }
-    if (over) {
-      for (Index v : added) marked[static_cast<std::size_t>(v)] = 0;
+      if (!marked[static_cast<std::size_t>(v)]) marked[static_cast<std::size_t>(v)] = 1, seeds.push_back(v);
+    const std::vector<Index> corners = seeds;
+    const std::size_t extra = close_marks(mesh, around, marked, std::move(seeds), budget);
+    if (extra > budget) {
+      for (Index v : corners) marked[static_cast<std::size_t>(v)] = 0;
     } else {
       ++accepted;
       promoted += extra;
@@ -169,7 +151,7 @@ BoundaryRefineReport refine_boundary(const Region& region, ExtractResult& extrac
     if (accepted == 0) break;
     for (std::uint8_t m : marked) report.marked_vertices += m;
     RefineResult r = refine(mesh, std::move(marked));
-    report.promoted_vertices += promoted + r.promoted_vertices;  // the second is 0: the marks are closed already
+    report.promoted_vertices += promoted;  // refine() adds none: the marks are closed already
     const auto n_new = static_cast<Index>(r.mesh.points.size());
 
     // Places of the new vertices, then the new boundary vertices onto their surfaces. A new

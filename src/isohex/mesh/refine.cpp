@@ -246,6 +246,13 @@ Key key_of(const Hex& hex, const P3& p) {
   return k;
 }
 
+// Bit c set when corner c of the hex is marked.
+std::uint8_t corner_mask(const Hex& h, const std::vector<std::uint8_t>& marked) {
+  std::uint8_t m = 0;
+  for (int c = 0; c < 8; ++c) m |= static_cast<std::uint8_t>(marked[h[c]] << c);
+  return m;
+}
+
 }  // namespace
 
 const char* refine_template_name(RefineTemplate t) {
@@ -260,6 +267,31 @@ const char* refine_template_name(RefineTemplate t) {
 }
 
 std::uint8_t promoted_mask(std::uint8_t corner_mask) { return tables().promoted[corner_mask]; }
+
+std::size_t close_marks(const HexMesh& mesh, const Incidence& around, std::vector<std::uint8_t>& marked,
+                        std::vector<Index> seeds, std::size_t limit) {
+  const Tables& tab = tables();
+  std::vector<Index> added;
+  while (!seeds.empty()) {
+    const Index v = seeds.back();
+    seeds.pop_back();
+    for (Index k = around.offsets[v]; k < around.offsets[v + 1]; ++k) {
+      const Hex& hx = mesh.hexes[around.ids[k]];
+      const std::uint8_t m = corner_mask(hx, marked), p = tab.promoted[m];
+      for (int c = 0; c < 8; ++c) {
+        if (!(p >> c & 1) || (m >> c & 1)) continue;
+        marked[hx[c]] = 1;
+        added.push_back(hx[c]);
+        seeds.push_back(hx[c]);
+        if (added.size() > limit) {
+          for (Index a : added) marked[a] = 0;
+          return limit + 1;
+        }
+      }
+    }
+  }
+  return added.size();
+}
 
 RefineTemplate template_of(std::uint8_t corner_mask) {
   if (promoted_mask(corner_mask) != corner_mask)
@@ -290,23 +322,11 @@ RefineResult refine(const HexMesh& mesh, std::vector<std::uint8_t> marked) {
   for (auto& f : marked) f = f != 0;
   r.marked_vertices = static_cast<std::size_t>(std::count(marked.begin(), marked.end(), 1));
 
-  auto mask_of = [&](const Hex& h) {
-    std::uint8_t m = 0;
-    for (int c = 0; c < 8; ++c) m |= static_cast<std::uint8_t>(marked[h[c]] << c);
-    return m;
-  };
-  for (bool changed = true; changed;) {
-    changed = false;
-    ++r.promotion_sweeps;
-    for (const Hex& h : mesh.hexes) {
-      const std::uint8_t m = mask_of(h), p = tab.promoted[m];
-      if (p == m) continue;
-      for (int c = 0; c < 8; ++c)
-        if (p >> c & 1) marked[h[c]] = 1;
-      changed = true;
-    }
-  }
-  r.promoted_vertices = static_cast<std::size_t>(std::count(marked.begin(), marked.end(), 1)) - r.marked_vertices;
+  std::vector<Index> seeds;
+  for (Index v = 0; v < mesh.num_vertices(); ++v)
+    if (marked[v]) seeds.push_back(v);
+  r.promoted_vertices = close_marks(mesh, vertex_hexes(mesh), marked, std::move(seeds));
+  auto mask_of = [&](const Hex& h) { return corner_mask(h, marked); };
 
   // Boundary edges and quads, to decide which new vertices inherit a fixed flag.
   std::set<std::array<Index, 4>> fixed_quads;

@@ -27,6 +27,7 @@
 /// position is the weighted sum in that order, so it is bit-identical from either side.
 
 #include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/mesh/topology.hpp"
 
 #include <array>
 #include <cstddef>
@@ -56,7 +57,6 @@ struct RefineResult {
   std::vector<std::uint8_t> marked;    ///< per input vertex, marked after promotion
   std::size_t marked_vertices = 0;     ///< vertices marked on input
   std::size_t promoted_vertices = 0;   ///< vertices marked by promotion
-  std::size_t promotion_sweeps = 0;    ///< sweeps over the mesh until nothing changed
   /// Number of input hexes refined by each template (indexed by RefineTemplate).
   std::array<std::size_t, kNumRefineTemplates> parents{};
   /// Number of output hexes made by each template.
@@ -76,6 +76,14 @@ std::vector<std::uint8_t> marked_vertices_of(const HexMesh& mesh, const std::vec
 
 /// The smallest valid configuration containing `corner_mask` (bit c = VTK corner c marked).
 std::uint8_t promoted_mask(std::uint8_t corner_mask);
+
+/// Promotes the marks around `seeds` (vertices just marked) until every hex around a marked
+/// vertex has a template configuration: the least such superset, whatever the order, since
+/// promotion is monotone. `around` is vertex_hexes(mesh). Returns the number of vertices it
+/// marked; if that would exceed `limit`, it unmarks them again (not the seeds) and returns
+/// limit + 1. refine() runs it on all marks without a limit.
+std::size_t close_marks(const HexMesh& mesh, const Incidence& around, std::vector<std::uint8_t>& marked,
+                        std::vector<Index> seeds, std::size_t limit = static_cast<std::size_t>(-2));
 
 /// The template of a valid configuration (promoted_mask(m) == m).
 RefineTemplate template_of(std::uint8_t corner_mask);
