@@ -6,7 +6,6 @@
 #include "mesh_stages.hpp"
 
 #include "isohex/contour/dual_contour.hpp"
-#include "isohex/contour/refine_boundary.hpp"
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
@@ -186,28 +185,9 @@ void run(const Args& a) {
   rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes));
   nlohmann::json refinement;
   if (a.refine_tolerance) {
-    if (terminal) fmt::print("  boundary refinement...\n"), std::fflush(stdout);
-    contour::BoundaryRefineOptions ro;
-    ro.chord_tolerance = *a.refine_tolerance;
-    ro.levels = a.refine_levels;
-    const contour::BoundaryRefineReport rr = contour::refine_boundary(region, out, ro);
-    fmt::print("boundary refinement: {} quads chord the surface deeper than {:.3g} h (deepest {:.3g} h), {} refined "
-               "within the templates' budget; {} levels, "
-               "{} -> {} hexes ({} vertices marked, {} by the templates); {} new boundary vertices projected ({} "
-               "failed); deepest chord now {:.3g} h, {} quads over; mean chord {:.3g} h -> {:.3g} h; {} quads more than h off "
-               "the surface left alone\n",
-               rr.coarse_quads, ro.chord_tolerance, rr.max_chord_before, rr.refined_quads, rr.levels, rr.hexes_before, rr.hexes_after,
-               rr.marked_vertices, rr.promoted_vertices, rr.projected_vertices, rr.projection_failures,
-               rr.max_chord_after, rr.coarse_quads_after, rr.mean_chord_before, rr.mean_chord_after,
-               rr.unreachable_quads);
-    refinement = {{"chord_tolerance", ro.chord_tolerance}, {"levels", rr.levels}, {"coarse_quads", rr.coarse_quads}, {"refined_quads", rr.refined_quads},
-                  {"coarse_quads_after", rr.coarse_quads_after}, {"unreachable_quads", rr.unreachable_quads}, {"max_chord_before", rr.max_chord_before},
-                  {"max_chord_after", rr.max_chord_after},
-                  {"mean_chord_before", rr.mean_chord_before}, {"mean_chord_after", rr.mean_chord_after}, {"hexes_before", rr.hexes_before},
-                  {"hexes_after", rr.hexes_after}, {"marked_vertices", rr.marked_vertices},
-                  {"promoted_vertices", rr.promoted_vertices}, {"projected_vertices", rr.projected_vertices},
-                  {"projection_failures", rr.projection_failures}};
-    rows.push_back(stage_row("boundary refinement", out.mesh, rr.seconds));
+    double seconds = 0;
+    refinement = refine_stage(region, out, *a.refine_tolerance, a.refine_levels, terminal, seconds);
+    rows.push_back(stage_row("boundary refinement", out.mesh, seconds));
   }
   auto t = Clock::now();
   // Scans have no sharp features: every crease of their quads is a fold.

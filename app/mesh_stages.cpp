@@ -1,6 +1,7 @@
 #include "mesh_stages.hpp"
 
 #include "isohex/contour/dual_contour.hpp"
+#include "isohex/contour/refine_boundary.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
@@ -35,6 +36,39 @@ nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_plac
                       {"min_new_sj", p.min_new_scaled_jacobian}};
   mesh = std::move(p.mesh);
   return j;
+}
+
+nlohmann::json refine_stage(const contour::Region& region, contour::ExtractResult& extracted, double tolerance,
+                            int levels, bool terminal, double& seconds) {
+  if (terminal) fmt::print("  boundary refinement...\n"), std::fflush(stdout);
+  contour::BoundaryRefineOptions ro;
+  ro.chord_tolerance = tolerance;
+  ro.levels = levels;
+  const contour::BoundaryRefineReport r = contour::refine_boundary(region, extracted, ro);
+  fmt::print("boundary refinement: {} quads chord the surface deeper than {:.3g} h (deepest {:.3g} h), {} refined "
+             "within the templates' budget; {} levels, {} -> {} hexes ({} vertices marked, {} by the templates); {} "
+             "new boundary vertices projected ({} failed); deepest chord now {:.3g} h, {} quads over; mean chord "
+             "{:.3g} h -> {:.3g} h; {} quads more than h off the surface left alone\n",
+             r.coarse_quads, tolerance, r.max_chord_before, r.refined_quads, r.levels, r.hexes_before, r.hexes_after,
+             r.marked_vertices, r.promoted_vertices, r.projected_vertices, r.projection_failures, r.max_chord_after,
+             r.coarse_quads_after, r.mean_chord_before, r.mean_chord_after, r.unreachable_quads);
+  seconds = r.seconds;
+  return {{"chord_tolerance", tolerance},
+          {"levels", r.levels},
+          {"coarse_quads", r.coarse_quads},
+          {"refined_quads", r.refined_quads},
+          {"coarse_quads_after", r.coarse_quads_after},
+          {"unreachable_quads", r.unreachable_quads},
+          {"max_chord_before", r.max_chord_before},
+          {"max_chord_after", r.max_chord_after},
+          {"mean_chord_before", r.mean_chord_before},
+          {"mean_chord_after", r.mean_chord_after},
+          {"hexes_before", r.hexes_before},
+          {"hexes_after", r.hexes_after},
+          {"marked_vertices", r.marked_vertices},
+          {"promoted_vertices", r.promoted_vertices},
+          {"projected_vertices", r.projected_vertices},
+          {"projection_failures", r.projection_failures}};
 }
 
 ProgressCallback progress_printer(std::FILE* out) {

@@ -2,6 +2,7 @@
 // The stages `isohex mesh` runs after extraction and surface smoothing: boundary pillowing,
 // untangling + shape optimisation with the boundary fixed or sliding, and the per-stage summary table.
 
+#include "isohex/contour/dual_contour.hpp"
 #include "isohex/contour/region.hpp"
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/optimize/optimize.hpp"
@@ -33,6 +34,11 @@ StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds)
 /// `vertex_place` (one entry per vertex, see contour::ExtractResult) grows with the new
 /// vertices, which are interior. Returns the JSON facts of the stage.
 nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, bool terminal);
+
+/// `isohex mesh --refine-boundary TOL`: contour::refine_boundary() on the extraction, its line
+/// printed; returns its JSON facts and sets `seconds`.
+nlohmann::json refine_stage(const contour::Region& region, contour::ExtractResult& extracted, double tolerance,
+                            int levels, bool terminal, double& seconds);
 
 /// A progress callback printing one line per iteration to `out` (flushed).
 ProgressCallback progress_printer(std::FILE* out);
