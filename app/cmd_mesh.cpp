@@ -47,6 +47,7 @@ struct Args {
   std::optional<double> refine_tolerance;  ///< --refine-boundary TOL
   int refine_levels = 1;
   std::optional<double> feature_angle;
+  double surface_band = 0.3;  ///< --surface-band, in cell sizes
   int* threads = nullptr;
 };
 
@@ -215,11 +216,13 @@ void run(const Args& a) {
     rows.back().extra = pillowing;
   }
   std::size_t inverted_left = 0;
+  std::vector<std::uint8_t> released;  // vertices the optimisation released into the band
   if (!a.no_smooth) {
     t = Clock::now();
     SlideSpec slide;
-    if (slides) slide = {&region, &out.vertex_place, spec.outer.kind == contour::OuterBoundary::Kind::box, feature_angle};
-    optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide);
+    if (slides)
+      slide = {&region, &out.vertex_place, feature_angle, a.surface_band * r.grid.h};
+    optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide, &released);
     rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t)));
     rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
                          {"shape sweeps", optimisation["shape"]["iterations"]},
@@ -228,7 +231,7 @@ void run(const Args& a) {
 
   t = Clock::now();
   const ValidationReport check = validate(out.mesh);
-  const contour::SurfaceDistance dist = contour::surface_distance(region, out.mesh, out.vertex_place);
+  const contour::SurfaceDistance dist = contour::surface_distance(region, out.mesh, out.vertex_place, &released);
   const std::vector<double> sj = scaled_jacobians(out.mesh);
   const MetricSummary summary = summarize(HexMetric::scaled_jacobian, sj);
   const double check_time = seconds_since(t);
@@ -252,6 +255,15 @@ void run(const Args& a) {
   fmt::print("  distance to the isosurface: max |f - iso| / range = {:.3g} over {} vertices ({} above 1e-6; {} box "
              "vertices not checked; {} projection fallbacks)\n",
              dist.max_relative, dist.checked, dist.off_surface, dist.box_vertices, r.projection_fallbacks);
+  // The vertices released into the band (--surface-band), apart: their distance in world units.
+  double released_far = 0, band = 0;
+  if (dist.released > 0) {
+    released_far = optimisation["boundary"]["max_loose_distance"].get<double>();
+    band = optimisation["boundary"]["band"].get<double>();
+    fmt::print("  released into the band: {} vertices, up to {:.3g} from their surface ({:.2f} cells; band {:.3g}), "
+               "max |f - iso| / range {:.3g}\n",
+               dist.released, released_far, released_far / r.grid.h, band, dist.released_max_relative);
+  }
   if (region.surfaces.size() > 1 || dist.box_vertices > 0) {
     // Each surface against its own scale (value range, radius), and the box vertices, which may
     // slide in an outer box's faces, against the box.
@@ -270,8 +282,12 @@ void run(const Args& a) {
              check_time, write_time);
   print_stage_table(rows);
   const double peak = peak_memory_mib();
-  fmt::print("boundary distance to the isosurface: max |f - iso| / range {:.3g}; total {:.2f} s; peak memory {:.0f} MiB\n",
-             dist.max_relative, seconds_since(start), peak);
+  fmt::print("boundary distance to the isosurface: max |f - iso| / range {:.3g}{}; total {:.2f} s; peak memory {:.0f} MiB\n",
+             dist.max_relative,
+             dist.released ? fmt::format(" ({} released vertices within {:.3g} = {:.2f} cells)", dist.released, released_far,
+                                         released_far / r.grid.h)
+                           : "",
+             seconds_since(start), peak);
 
   if (!a.json.empty() || !a.report.empty()) {
     nlohmann::json j;
@@ -317,6 +333,9 @@ void run(const Args& a) {
     j["projection_fallbacks"] = r.projection_fallbacks;
     j["max_relative_distance"] = dist.max_relative;
     j["off_surface_vertices"] = dist.off_surface;
+    j["released_vertices"] = dist.released;
+    j["released_max_relative_distance"] = dist.released_max_relative;
+    j["released_max_distance"] = released_far;
     nlohmann::json per = nlohmann::json::array();
     for (std::size_t k = 0; k < region.surfaces.size(); ++k)
       per.push_back({{"surface", region.surfaces[k].describe()},
@@ -347,7 +366,7 @@ void run(const Args& a) {
     }
   }
   // A mesh a solver would refuse fails the run (it is written all the same, for inspection).
-  if (!check.valid() || dist.off_surface > 0 || inverted_left > 0) exit_code() = 1;
+  if (!check.valid() || dist.off_surface > 0 || released_far > band * (1 + 1e-3) || inverted_left > 0) exit_code() = 1;
 }
 
 }  // namespace
@@ -395,11 +414,16 @@ void register_mesh(CLI::App& app) {
   const std::map<std::string, bool> boundary_names{{"fixed", false}, {"slide", true}};
   cmd->add_option("--boundary", a->slide,
                   "Boundary vertices in the optimisation: slide (the default: each moves on its own surface, an "
-                  "isosurface, the --outer sphere or an --outer box's face, and is reprojected onto it; vertices on "
-                  "creases (--feature-angle), where two surfaces meet and on the domain box, unless that is the --outer "
-                  "box, pinned) or fixed "
+                  "isosurface, the --outer sphere or a face of the domain box (the volume's or the --outer box), and is "
+                  "reprojected onto it; vertices on creases (--feature-angle), where two surfaces meet and on the box's "
+                  "edges pinned) or fixed "
                   "(where they are after surface smoothing, the paper's setting)")
       ->transform(CLI::CheckedTransformer(boundary_names, CLI::ignore_case));
+  cmd->add_option("--surface-band", a->surface_band,
+                  "With --boundary slide: where hexes stay below 0.2 with their boundary on the surface (knife edges "
+                  "thinner than a cell), release those boundary vertices into a band of this many cell sizes about "
+                  "their surface and optimise again (default 0.3; 0: every vertex stays on its surface)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
   cmd->add_option("--report", a->report,

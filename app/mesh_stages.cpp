@@ -2,6 +2,7 @@
 
 #include "isohex/contour/dual_contour.hpp"
 #include "isohex/contour/refine_boundary.hpp"
+#include "isohex/mesh/topology.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
@@ -129,22 +130,24 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
   return j;
 }
 
-nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide) {
+nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide,
+                              std::vector<std::uint8_t>* released_mask) {
   std::unique_ptr<BoundarySurface> surface;
   if (slide.region) {
     std::vector<contour::LevelSet> surfaces = slide.region->surfaces;
     std::vector<std::int8_t> place = *slide.vertex_place;
     place.resize(mesh.points.size(), contour::kInteriorVertex);
-    if (slide.outer_box) {
-      // A box vertex slides in the face it lies in; BoundarySurface pins those that lie in two
-      // (the box's edges and corners) or on an isosurface too (where it meets the box).
-      const std::size_t first = surfaces.size();
-      for (const contour::LevelSet& f : contour::box_faces(slide.region->domain)) surfaces.push_back(f);
-      for (std::size_t v = 0; v < place.size(); ++v)
-        for (std::size_t f = first; place[v] == contour::kBoxVertex && f < surfaces.size(); ++f)
-          if (surfaces[f].on(mesh.points[v])) place[v] = static_cast<std::int8_t>(f);
-    }
+    // A box vertex slides in the face it lies in, whether the box is an --outer box or the
+    // volume's box cutting the solid (a scan cut at the neck: the cut is a plane too);
+    // BoundarySurface pins those that lie in two (the box's edges and corners) or on an
+    // isosurface too (where it meets the box).
+    const std::size_t first = surfaces.size();
+    for (const contour::LevelSet& f : contour::box_faces(slide.region->domain)) surfaces.push_back(f);
+    for (std::size_t v = 0; v < place.size(); ++v)
+      for (std::size_t f = first; place[v] == contour::kBoxVertex && f < surfaces.size(); ++f)
+        if (surfaces[f].on(mesh.points[v])) place[v] = static_cast<std::int8_t>(f);
     surface = std::make_unique<BoundarySurface>(mesh, std::move(surfaces), place, slide.feature_degrees);
+    surface->set_domain(slide.region->domain);
     // " on the S" for one surface, ": a on the S, b on the T" for several.
     std::vector<std::size_t> used;
     for (std::size_t k = 0; k < surface->surfaces().size(); ++k)
@@ -164,10 +167,44 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
     o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
   }
   nlohmann::json j = run_optimisation(mesh, fixed, o);
+  nlohmann::json released = nlohmann::json::array();
+  if (surface && slide.band > 0) {
+    // Where the surface itself leaves no valid or good place for the hexes at it (knife edges
+    // one voxel thick), its vertices of those hexes are released into the band and the whole
+    // sequence runs again. Two more rounds catch what is still below 0.2, reaching one ring
+    // of hexes further (an inner hex squeezed between sheets has no boundary vertex itself).
+    const Incidence inc = vertex_hexes(mesh);
+    for (int round = 1; round <= 3; ++round) {
+      const std::vector<double> sj = scaled_jacobians(mesh);
+      std::vector<Index> candidates;
+      const auto add = [&](Index h) {
+        for (Index v : mesh.hexes[h])
+          if (surface->role(v) != BoundarySurface::Role::interior) candidates.push_back(v);
+      };
+      for (Index h = 0; h < mesh.num_hexes(); ++h) {
+        if (!(sj[h] < 0.2 || is_degenerate(sj[h]))) continue;
+        add(h);
+        if (round > 1)
+          for (Index v : mesh.hexes[h])
+            for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) add(inc.ids[k]);
+      }
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+      const std::size_t n = surface->loosen(mesh, candidates, slide.band);
+      if (n == 0) break;
+      fmt::print("boundary: {} vertices of hexes below 0.2 released into a band of {:.3g} about their surface; "
+                 "optimising again\n", n, slide.band);
+      nlohmann::json again = run_optimisation(mesh, surface->fixed_mask(), o);
+      again["released"] = n;
+      released.push_back(again);
+    }
+  }
   if (surface) {
-    double far = 0;
-    for (Index v = 0; v < mesh.num_vertices(); ++v)
+    double far = 0, off = 0;
+    for (Index v = 0; v < mesh.num_vertices(); ++v) {
       if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(v, mesh.points[v]));
+      if (surface->role(v) == BoundarySurface::Role::loose) off = std::max(off, surface->offset(v, mesh.points[v]));
+    }
     nlohmann::json per = nlohmann::json::object();
     for (std::size_t k = 0; k < surface->surfaces().size(); ++k)
       if (const std::size_t n = surface->num_sliding_on(k); n > 0) per[surface->surfaces()[k].describe()] = n;
@@ -175,7 +212,18 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
                      {"sliding", surface->num_sliding()},
                      {"sliding_per_surface", per},
                      {"pinned", surface->num_pinned()},
-                     {"max_relative_level", far}};
+                     {"max_relative_level", far},
+                     {"band", slide.band},
+                     {"loose", surface->num_loose()},
+                     {"max_loose_distance", off},
+                     {"rounds", released}};
+    if (released_mask) {
+      released_mask->assign(mesh.points.size(), 0);
+      for (Index v = 0; v < mesh.num_vertices(); ++v) (*released_mask)[v] = surface->role(v) == BoundarySurface::Role::loose;
+    }
+    if (surface->num_loose() > 0)
+      fmt::print("boundary: {} vertices within {:.3g} of their surface (band {:.3g}); the other {} on it\n",
+                 surface->num_loose(), off, slide.band, surface->num_sliding());
   } else {
     j["boundary"] = {{"mode", "fixed"}};
   }

@@ -50,21 +50,26 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 
 /// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
 /// (`--boundary slide`): each boundary vertex on its own surface, the one `vertex_place` names
-/// among region->surfaces. Vertices on the domain box are pinned, except where the box is an
-/// outer box (`outer_box`): there a vertex on one face slides in it, those on its edges and
-/// corners stay. Vertices where two surfaces meet, or on creases sharper than
-/// `feature_degrees`, are pinned (BoundarySurface).
+/// among region->surfaces. A vertex on one face of the domain box (an --outer box, or the
+/// volume's box where it cuts the solid) slides in it; those on its edges and corners stay.
+/// Vertices where two surfaces meet, or on creases sharper than `feature_degrees`, are pinned
+/// (BoundarySurface).
 struct SlideSpec {
   const contour::Region* region = nullptr;
   const std::vector<std::int8_t>* vertex_place = nullptr;
-  bool outer_box = false;
   double feature_degrees = 30;
+  /// Band (world units) about their surface into which the sliding vertices of the hexes still
+  /// below 0.2 after a first optimisation are released for a second one (`--surface-band`;
+  /// 0: every sliding vertex stays on its surface).
+  double band = 0;
 };
 
 /// `isohex mesh`'s stage: run_optimisation() with the boundary fixed (or sliding, see SlideSpec)
 /// and default options (the same as `isohex smooth --untangle`). Returns the JSON facts of the
 /// stage; `inverted_left` is set to the hexes still inverted or degenerate at the end.
-nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide = {});
+/// `released` (may be null) receives 1 for each vertex released into the band.
+nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide = {},
+                              std::vector<std::uint8_t>* released = nullptr);
 
 /// Prints the table of rows (hexes, vertices, min/mean SJ, #<0, #<0.2, time).
 void print_stage_table(const std::vector<StageRow>& rows);

@@ -480,3 +480,75 @@ TEST(OptimizeSlide, MeshCliSlidesInTheFacesOfAnOuterBox) {
   EXPECT_GT(edges, 12u);
   EXPECT_GT(moved, 20u);
 }
+
+// Released vertices (loosen): they leave the isosurface, but never by more than the band
+// (measured on the distance field itself: |f − 1| is the distance to the unit sphere), the
+// others stay on it, nothing is inverted, the shape is at least as good as sliding, and the
+// bits are the same with one thread.
+TEST(OptimizeSlide, LooseVerticesStayWithinTheirBand) {
+  const Volume volume = distance_volume(41);
+  const IsoField field(volume, 1.0, Inside::below);
+  const HexMesh in = distorted_iso_ball(field);
+  const auto run = [&](int threads, double band) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    Outcome r{in};
+    BoundarySurface surface(in, field);
+    std::vector<Index> half;
+    for (Index v = 0; v < in.num_vertices(); ++v)
+      if (surface.role(v) == BoundarySurface::Role::slides && v % 2 == 0) half.push_back(v);
+    EXPECT_EQ(surface.loosen(in, half, band), half.size());
+    EXPECT_EQ(surface.num_loose(), half.size());
+    surface.set_domain(Aabb{Vec3::Constant(-1.5), Vec3::Constant(1.5)});
+    optimise_into(r, &surface, true);
+    std::size_t off = 0;
+    for (Index v = 0; v < in.num_vertices(); ++v) {
+      const Vec3& p = r.mesh.points[v];
+      if (surface.role(v) == BoundarySurface::Role::slides)
+        EXPECT_LE(std::abs(field.level(p)), 1e-6 * field.value_range()) << v;
+      if (surface.role(v) != BoundarySurface::Role::loose) continue;
+      // The band, plus the trilinear field's own error against the true distance (h = 0.075).
+      EXPECT_LE(std::abs(p.norm() - 1.0), band + 2e-3) << v;
+      EXPECT_LE(surface.offset(v, p), band * (1 + 1e-3)) << v;
+      off += std::abs(field.level(p)) > 1e-6 * field.value_range();
+    }
+    EXPECT_GT(off, 10u);
+    return r;
+  };
+  const Outcome two = run(2, 0.05), one = run(1, 0.05);
+  const Outcome slide = optimise_iso(in, &field, 2);
+  EXPECT_EQ(two.inverted, 0u);
+  EXPECT_GE(two.min_sj, slide.min_sj - 1e-9);
+  EXPECT_EQ(one.mesh.points, two.mesh.points);
+}
+
+// band_clamp: a point far off is brought back to the band's distance from its foot point,
+// inside the domain box; a pinned vertex on the isosurface (a rim) is released about it, one
+// off every surface is not.
+TEST(OptimizeSlide, BandClampAndReleasedRims) {
+  const Volume volume = distance_volume(41);
+  const IsoField field(volume, 1.0, Inside::below);
+  HexMesh in = distorted_iso_ball(field);
+  const auto boundary = boundary_vertex_mask(in);
+  Index rim = -1, off = -1;
+  for (Index v = 0; v < in.num_vertices(); ++v)
+    if (boundary[v]) (rim < 0 ? rim : off) = v;
+  in.points[off] *= 1.05;  // off the isosurface: pinned, and not released
+  std::vector<std::uint8_t> pin(in.points.size(), 0);
+  pin[rim] = 1;
+  BoundarySurface surface(in, field, 30.0, &pin);
+  ASSERT_EQ(surface.role(rim), BoundarySurface::Role::pinned);
+  surface.set_domain(Aabb{Vec3::Constant(-1.5), Vec3::Constant(1.2)});
+  EXPECT_EQ(surface.loosen(in, {rim, off}, 0.1), 1u);
+  EXPECT_EQ(surface.role(rim), BoundarySurface::Role::loose);
+  EXPECT_EQ(surface.role(off), BoundarySurface::Role::pinned);
+  EXPECT_EQ(surface.fixed_mask()[rim], 0);
+  Vec3 x = in.points[rim] * 1.4;
+  ASSERT_TRUE(surface.band_clamp(rim, x, 0.5));
+  EXPECT_NEAR(x.norm(), 1.1, 3e-3);
+  EXPECT_NEAR(surface.offset(rim, x), 0.1, 1e-6);
+  EXPECT_LE(x.maxCoeff(), 1.2);
+  x = Vec3(1.19, 0, 0) + 0.9 * in.points[rim].normalized();  // beyond the box's upper faces: clamped into it
+  ASSERT_TRUE(surface.band_clamp(rim, x, 2.0));
+  EXPECT_LE(x.maxCoeff(), 1.2);
+  EXPECT_LE(surface.offset(rim, x), 0.1 * (1 + 1e-6));
+}

@@ -218,8 +218,31 @@ Placement place_vertex(const Region& region, const SampledGrid& g, std::size_t i
     return {x, static_cast<std::int8_t>(surface), true};
   }
   Vec3 y = x;
-  if (region.surfaces[static_cast<std::size_t>(surface)].project(y, h)) return {y, static_cast<std::int8_t>(surface), false};
-  // Fall back to the crossing nearest to the clamped minimiser: it is on the surface.
+  const LevelSet& ls = region.surfaces[static_cast<std::size_t>(surface)];
+  if (ls.project(y, h)) return {y, static_cast<std::int8_t>(surface), false};
+  // Fall back to the zero on the segment from the clamped minimiser, strictly inside the cell,
+  // to the nearest corner on the other side: a point inside the cell. (Not a crossing on the
+  // cell's edges: the cells around an edge would all take its crossing, one point for several
+  // dual vertices, collapsed quad edges and degenerate hexes that no optimiser can open.) A
+  // corner exactly at the isovalue is shared too and is not used.
+  const bool x_in = ls.level(x) > 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  Vec3 other = x;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 q = lo + h * Vec3(c & 1, c >> 1 & 1, c >> 2 & 1);
+    const double lq = ls.level(q);
+    if ((x_in ? lq > 0 : !(lq > 0)) || std::abs(lq) <= ls.tolerance()) continue;
+    const double d = (q - x).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      other = q;
+    }
+  }
+  if (best_d < std::numeric_limits<double>::infinity()) {
+    const Vec3 z = x_in ? ls.root(x, other) : ls.root(other, x);
+    if (std::abs(ls.level(z)) <= ls.tolerance()) return {z, static_cast<std::int8_t>(surface), true};
+  }
+  // Else the crossing nearest to the clamped minimiser: it is on the surface.
   int nearest = -1;
   for (int c = 0; c < num_crossings; ++c)
     if (crossings[c].surface == surface &&
@@ -406,7 +429,8 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   return out;
 }
 
-SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, const std::vector<std::int8_t>& place) {
+SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, const std::vector<std::int8_t>& place,
+                                 const std::vector<std::uint8_t>* released) {
   SurfaceDistance d;
   const auto n = static_cast<Index>(mesh.points.size());
   std::vector<double> rel(static_cast<std::size_t>(n), -1);
@@ -427,6 +451,11 @@ SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, cons
       d.box_max_relative = std::max(d.box_max_relative, to_box / side);
     }
     if (rel[v] < 0) continue;
+    if (released && v < released->size() && (*released)[v]) {
+      ++d.released;
+      d.released_max_relative = std::max(d.released_max_relative, rel[v]);
+      continue;
+    }
     ++d.checked;
     d.max_relative = std::max(d.max_relative, rel[v]);
     d.off_surface += rel[v] > 1e-6;

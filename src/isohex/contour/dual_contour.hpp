@@ -135,7 +135,12 @@ struct SurfaceDistance {
   /// max over the box vertices of their distance to the domain box's surface / its largest side
   /// (they may slide in its faces: optimize/slide.hpp).
   double box_max_relative = 0;
+  /// Vertices the optimisation released into a band about their surface (`released`, see
+  /// BoundarySurface::loosen), measured apart: not in the figures above.
+  std::size_t released = 0;
+  double released_max_relative = 0;  ///< max |L_k(v)| / scale over them
 };
-SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, const std::vector<std::int8_t>& vertex_place);
+SurfaceDistance surface_distance(const Region& region, const HexMesh& mesh, const std::vector<std::int8_t>& vertex_place,
+                                 const std::vector<std::uint8_t>* released = nullptr);
 
 }  // namespace isohex::contour

@@ -193,6 +193,8 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   // the facing test), so the energy is compared at points of the surface only. A step that
   // cannot be put back is refused.
   const bool slides = params.surface && params.surface->role(v) == BoundarySurface::Role::slides;
+  // A loose vertex steps freely and is clamped back into the band about its surface.
+  const bool loose = params.surface && params.surface->role(v) == BoundarySurface::Role::loose;
   Vec3 n = Vec3::Zero();
   if (slides) {
     if (!params.surface->tangent_normal(v, m.x, n)) return m;
@@ -206,6 +208,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   for (int i = 0; i < 30; ++i, t *= 0.5) {
     Vec3 x = m.x + t * d;
     if (slides && !params.surface->reproject(v, x, n, len)) continue;
+    if (loose && !params.surface->band_clamp(v, x, len)) continue;
     const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
     if (e < e0 && e <= e0 + 1e-4 * t * slope) {
       m.x = x;

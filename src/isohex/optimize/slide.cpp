@@ -110,6 +110,62 @@ bool BoundarySurface::reproject(Index v, Vec3& x, const Vec3& n, double len) con
   return true;
 }
 
+std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band) {
+  std::size_t n = 0;
+  for (Index v : vertices) {
+    if (v < 0 || static_cast<std::size_t>(v) >= role_.size()) continue;
+    if (role_[v] == static_cast<std::uint8_t>(Role::pinned)) {
+      // A rim vertex: about the first isosurface it is on (box faces and spheres are exact).
+      std::size_t k = 0;
+      while (k < surfaces_.size() && !(surfaces_[k].field() && surfaces_[k].on(mesh.points[v]))) ++k;
+      if (k == surfaces_.size()) continue;
+      target_[v] = static_cast<std::int8_t>(k);
+      --pinned_;
+    } else if (role_[v] == static_cast<std::uint8_t>(Role::slides)) {
+      --sliding_;
+    } else {
+      continue;
+    }
+    role_[v] = static_cast<std::uint8_t>(Role::loose);
+    ++n;
+  }
+  loose_ += n;
+  band_ = band;
+  return n;
+}
+
+bool BoundarySurface::band_clamp(Index v, Vec3& x, double len) const {
+  // Box first, then band: the foot point is in the box, so the segment from it to x is too.
+  if (has_domain_) x = x.cwiseMax(domain_.lo).cwiseMin(domain_.hi);
+  if (!surfaces_.empty() && target(v) < 0) return false;
+  // The projection follows the gradient, not the straight line to the nearest point, so the
+  // foot seen from the clamped point can differ a little: a few rounds settle it.
+  // A step whose foot does not settle in a few rounds is refused.
+  for (int round = 0; round < 5; ++round) {
+    Vec3 foot = x;
+    if (surfaces_.empty()) foot = project(x);
+    else if (!surfaces_[target(v)].project(foot, len + band_)) return false;
+    const Vec3 d = x - foot;
+    const double dn = d.norm();
+    if (!(dn > band_ * (1 + 1e-6))) return true;
+    x = foot + d * (band_ / dn);
+  }
+  return false;
+}
+
+double BoundarySurface::offset(Index v, const Vec3& x) const {
+  Vec3 foot = x;
+  if (surfaces_.empty()) return (project(x) - x).norm();
+  if (target(v) < 0) return 0;
+  // A loose vertex is within the band of its foot point; a wider reach allows for a projection
+  // that does not go straight to the nearest point (and for a step clamped into the domain box).
+  if (surfaces_[target(v)].project(foot, 8 * band_ + 1e-300)) return (foot - x).norm();
+  // No foot point within reach (a flat spot of the field): the first-order distance |L| / |∇L|.
+  Vec3 g;
+  const double l = surfaces_[target(v)].level(x, g);
+  return g.norm() > 0 ? std::abs(l) / g.norm() : std::numeric_limits<double>::infinity();
+}
+
 double BoundarySurface::deviation(Index v, const Vec3& x) const {
   if (surfaces_.empty()) return (project(x) - x).norm();
   if (target(v) < 0) return 0;

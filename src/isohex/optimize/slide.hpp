@@ -32,7 +32,9 @@ namespace isohex {
 
 class BoundarySurface {
  public:
-  enum class Role : std::uint8_t { interior, slides, pinned };
+  /// `loose`: a sliding vertex released by loosen(): it moves freely within a band about its
+  /// target surface instead of on it.
+  enum class Role : std::uint8_t { interior, slides, pinned, loose };
 
   explicit BoundarySurface(const HexMesh& mesh, double feature_degrees = 30.0);
   /// Sliding on the isosurface of `field` (which must outlive this). `pin` (may be null or
@@ -62,6 +64,30 @@ class BoundarySurface {
   /// How far x is from v's target: the distance to the triangles, or |L| / scale.
   [[nodiscard]] double deviation(Index v, const Vec3& x) const;
 
+  /// Releases the sliding vertices among `vertices` (others are ignored) into a band of
+  /// half-width `band` (world units) about their target: they step freely in space and are
+  /// clamped back into the band (band_clamp). For a boundary that, kept exactly on the
+  /// isosurface, leaves elements that no interior placement can make valid: a knife edge
+  /// one voxel thick, whose quads face opposite ways at a vertex. Returns how many were released.
+  /// Pinned vertices that lie on an isosurface (a rim, where it meets the domain box) are
+  /// released about that isosurface too.
+  std::size_t loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band);
+  /// The box loose vertices must stay in (the domain: a band must not carry them out of it).
+  void set_domain(const Aabb& box) { domain_ = box; has_domain_ = true; }
+  /// Puts x, a step of loose vertex v (local edge length `len`), back within the band: into the
+  /// domain box if one is set, then x's foot point on v's target (the level set's projection, or the nearest triangle point) and,
+  /// if x is farther than the band from it, the point at the band's distance towards x. False
+  /// when the foot point cannot be found: the step must then be refused.
+  bool band_clamp(Index v, Vec3& x, double len) const;
+  /// The distance from x to its foot point on v's target (world units; 0 if there is none).
+  [[nodiscard]] double offset(Index v, const Vec3& x) const;
+  [[nodiscard]] double band() const { return band_; }
+  [[nodiscard]] std::size_t num_loose() const { return loose_; }
+  /// True for a vertex that moves with its surface: sliding on it or loose about it.
+  [[nodiscard]] bool moves_with_surface(Index v) const {
+    return role_[v] == static_cast<std::uint8_t>(Role::slides) || role_[v] == static_cast<std::uint8_t>(Role::loose);
+  }
+
   [[nodiscard]] Role role(Index v) const { return static_cast<Role>(role_[v]); }
   [[nodiscard]] std::size_t num_sliding() const { return sliding_; }
   [[nodiscard]] std::size_t num_pinned() const { return pinned_; }
@@ -84,7 +110,10 @@ class BoundarySurface {
   std::vector<std::uint8_t> role_;
   std::vector<contour::LevelSet> surfaces_;
   std::vector<std::int8_t> target_;  // per vertex: index into surfaces_, −1 unless sliding on one
-  std::size_t sliding_ = 0, pinned_ = 0;
+  std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
+  double band_ = 0;
+  Aabb domain_{Vec3::Zero(), Vec3::Zero()};
+  bool has_domain_ = false;
   std::vector<std::array<Vec3, 3>> tris_;
   std::vector<Vec3> normals_;
   // Uniform grid over the triangles' bounding box: cell c holds items[start[c] .. start[c+1]).

@@ -86,7 +86,7 @@ std::size_t lp_rescue(HexMesh& mesh, const VertexColoring& coloring, const Incid
   // The LP's moves are free in space: sliding boundary vertices keep to their Newton steps.
   if (surface)
     for (Index v = 0; v < mesh.num_vertices(); ++v)
-      if (surface->role(v) == BoundarySurface::Role::slides) active[v] = 0;
+      if (surface->moves_with_surface(v)) active[v] = 0;
   std::size_t moves = 0;
   for (int round = 0; round < 50; ++round) {
     const std::size_t m = opt::max_min_sweep(mesh, coloring, inc, inv_len, active, skip);
