@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -257,12 +258,14 @@ void run(const Args& a) {
              dist.max_relative, dist.checked, dist.off_surface, dist.box_vertices, r.projection_fallbacks);
   // The vertices released into the band (--surface-band), apart: their distance in world units.
   double released_far = 0, band = 0;
-  if (dist.released > 0) {
+  const auto num_released = static_cast<std::size_t>(std::count(released.begin(), released.end(), 1));
+  if (num_released > 0) {
     released_far = optimisation["boundary"]["max_loose_distance"].get<double>();
     band = optimisation["boundary"]["band"].get<double>();
-    fmt::print("  released into the band: {} vertices, up to {:.3g} from their surface ({:.2f} cells; band {:.3g}), "
-               "max |f - iso| / range {:.3g}\n",
-               dist.released, released_far, released_far / r.grid.h, band, dist.released_max_relative);
+    fmt::print("  released into the band: {} vertices ({} of them of the box's faces), up to {:.3g} from their surface "
+               "({:.2f} cells; band {:.3g}); max |f - iso| / range {:.3g}\n",
+               num_released, num_released - dist.released, released_far, released_far / r.grid.h, band,
+               dist.released_max_relative);
   }
   if (region.surfaces.size() > 1 || dist.box_vertices > 0) {
     // Each surface against its own scale (value range, radius), and the box vertices, which may
@@ -284,7 +287,7 @@ void run(const Args& a) {
   const double peak = peak_memory_mib();
   fmt::print("boundary distance to the isosurface: max |f - iso| / range {:.3g}{}; total {:.2f} s; peak memory {:.0f} MiB\n",
              dist.max_relative,
-             dist.released ? fmt::format(" ({} released vertices within {:.3g} = {:.2f} cells)", dist.released, released_far,
+             num_released ? fmt::format(" ({} released vertices within {:.3g} = {:.2f} cells)", num_released, released_far,
                                          released_far / r.grid.h)
                            : "",
              seconds_since(start), peak);

@@ -134,17 +134,31 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
   return n;
 }
 
+bool BoundarySurface::foot_point(Index v, const Vec3& x, double max_reach, Vec3& foot) const {
+  if (surfaces_.empty()) {
+    foot = project(x);
+    return true;
+  }
+  if (target(v) < 0) return false;
+  // The shortest reach first: the Newton walk of a wider one can wander off to a farther part
+  // of a noisy isosurface. The same sequence from the same point gives the same foot, so
+  // band_clamp() and offset() agree.
+  for (double reach = band_ > 0 ? band_ : max_reach;; reach = std::min(2 * reach, max_reach)) {
+    foot = x;
+    if (surfaces_[target(v)].project(foot, reach)) return true;
+    if (reach >= max_reach) return false;
+  }
+}
+
 bool BoundarySurface::band_clamp(Index v, Vec3& x, double len) const {
   // Box first, then band: the foot point is in the box, so the segment from it to x is too.
   if (has_domain_) x = x.cwiseMax(domain_.lo).cwiseMin(domain_.hi);
-  if (!surfaces_.empty() && target(v) < 0) return false;
   // The projection follows the gradient, not the straight line to the nearest point, so the
-  // foot seen from the clamped point can differ a little: a few rounds settle it.
-  // A step whose foot does not settle in a few rounds is refused.
+  // foot seen from the clamped point can differ a little: a few rounds settle it, and a step
+  // whose foot does not settle is refused.
+  Vec3 foot;
   for (int round = 0; round < 5; ++round) {
-    Vec3 foot = x;
-    if (surfaces_.empty()) foot = project(x);
-    else if (!surfaces_[target(v)].project(foot, len + band_)) return false;
+    if (!foot_point(v, x, round == 0 ? len + band_ : kFootReach * band_, foot)) return false;
     const Vec3 d = x - foot;
     const double dn = d.norm();
     if (!(dn > band_ * (1 + 1e-6))) return true;
@@ -154,12 +168,10 @@ bool BoundarySurface::band_clamp(Index v, Vec3& x, double len) const {
 }
 
 double BoundarySurface::offset(Index v, const Vec3& x) const {
-  Vec3 foot = x;
   if (surfaces_.empty()) return (project(x) - x).norm();
   if (target(v) < 0) return 0;
-  // A loose vertex is within the band of its foot point; a wider reach allows for a projection
-  // that does not go straight to the nearest point (and for a step clamped into the domain box).
-  if (surfaces_[target(v)].project(foot, 8 * band_ + 1e-300)) return (foot - x).norm();
+  Vec3 foot;
+  if (foot_point(v, x, kFootReach * band_, foot)) return (foot - x).norm();
   // No foot point within reach (a flat spot of the field): the first-order distance |L| / |∇L|.
   Vec3 g;
   const double l = surfaces_[target(v)].level(x, g);

@@ -105,6 +105,10 @@ class BoundarySurface {
 
  private:
   void classify(const HexMesh& mesh, double feature_degrees, bool keep_triangles);
+  /// v's foot point on its target from x: projections of growing reach (band_, doubled, up to
+  /// max_reach); false if none succeeds.
+  bool foot_point(Index v, const Vec3& x, double max_reach, Vec3& foot) const;
+  static constexpr double kFootReach = 8;  // × band: the reach from a point within the band
   void assign_targets(const HexMesh& mesh, const std::vector<std::int8_t>& place, const std::vector<std::uint8_t>* pin);
 
   std::vector<std::uint8_t> role_;
