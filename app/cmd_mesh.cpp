@@ -34,7 +34,7 @@ struct Args {
   std::optional<double> iso, iso2;
   std::string inside = "above", interpolation = "trilinear", region = "inside", outer;
   double cell_size = 0;
-  Index resolution = 0, min_component = 0;
+  Index resolution = 0, min_component = 8;
   // Raw layout (as in `isohex volume info`).
   std::vector<Index> dims;
   std::string type, endian = "little";
@@ -396,7 +396,9 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--iso2", a->iso2, "Second isovalue of --region between");
   cmd->add_option("--outer", a->outer, "Outer boundary of --region outside: sphere:CX,CY,CZ,R or box:X0,Y0,Z0,X1,Y1,Z1 "
                                        "(default the volume's box)");
-  cmd->add_option("--min-component", a->min_component, "Drop connected parts with fewer hexes");
+  cmd->add_option("--min-component", a->min_component,
+                  "Drop connected parts with fewer hexes (default 8: a part smaller than a 2x2x2 block of cells is below "
+                  "the cell size, mostly a scan's noise, and would float free in a solver; 0 keeps every part)");
   cmd->add_option("--refine-boundary", a->refine_tolerance,
                   "Refine (by 3, conforming templates) the hexes under boundary quads that chord the isosurface "
                   "deeper than TOL x cell size, new boundary vertices on the isosurface (e.g. 0.02)")
