@@ -126,6 +126,43 @@ def sheets(isohex, mesh, json_file, reuse):
         return json.load(f)
 
 
+def pipeline(a):
+    """`isohex mesh` with its defaults on every case: its own stage table, what the band released,
+    and the sheets after pillowing (from its report)."""
+    print("| case | extraction: hexes, min SJ, SJ < 0, SJ < 0.2 | final: hexes, min SJ, SJ < 0, SJ < 0.2 | "
+          "boundary captured by one sheet, hexes with ≥ 2 boundary faces | released vertices (max distance) | "
+          "parts dropped | time |")
+    print("|---|---|---|---|---|--:|--:|")
+    for name, prep, mesh_args in CASES:
+        if a.only and name not in a.only:
+            continue
+        work = os.path.join(a.work, name.replace(" ", "_"))
+        os.makedirs(work, exist_ok=True)
+        f = lambda s: s.format(work=work)
+        if prep:
+            out = f(prep[prep.index("-o") + 1])
+            run([a.isohex] + [f(x) for x in prep], out + ".time", out, a.reuse)
+        P = os.path.join(work, "pipeline.vtu")
+        t = run([a.isohex, "mesh"] + [f(x) for x in mesh_args] + ["-o", P, "--json", P + ".json"], P + ".time", P,
+                a.reuse, ok=(0, 1))
+        s = sheets(a.isohex, P, P + ".sheets.json", a.reuse)
+        with open(P + ".json") as fh:
+            j = json.load(fh)
+        st = {r["stage"]: r for r in j["stages"]}
+
+        def cell(r):
+            sj = r["scaled_jacobian"]
+            return f"{r['hexes']:,}, {sj['min']:.3f}, {sj['inverted'] + sj['degenerate']:,}, {r['below_0.2']:,}"
+
+        one = all(len(c["sheets"]) == 1 for c in s["boundary_components"])
+        multi = s["multi_boundary_hexes"]
+        rel = j["released_vertices"] + (j["optimisation"]["boundary"]["loose"] - j["released_vertices"])
+        far = j["released_max_distance"] / j["cell_size"]
+        print(f"| {name} | {cell(st['extraction'])} | {cell(st['optimisation'])} | "
+              f"{'yes' if one else 'no'} ({len(s['boundary_components'])} components), {multi} | "
+              f"{rel:,} ({far:.2f} cells) | {j['dropped_components']:,} | {t:.1f} s |")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--isohex", default="build-pillow/bin/isohex")
@@ -134,7 +171,12 @@ def main():
     ap.add_argument("--only", nargs="*")
     ap.add_argument("--without-pillow", nargs="*", default=[],
                     help="cases to also smooth straight from the extraction, for comparison")
+    ap.add_argument("--pipeline", action="store_true",
+                    help="instead: one `isohex mesh` per case with its defaults (pillowing, then sliding "
+                         "optimisation with the band release) and the table of its stages")
     a = ap.parse_args()
+    if a.pipeline:
+        return pipeline(a)
     rows, direct = [], []
     # Newer `isohex mesh` runs pillowing and smoothing itself unless told not to: the first
     # stage here is extraction + surface smoothing only.
