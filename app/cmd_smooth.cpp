@@ -6,6 +6,7 @@
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
+#include "isohex/mesh/topology.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/summary.hpp"
@@ -35,6 +36,7 @@ struct Args {
   FixedVertices fixed = FixedVertices::boundary;
   std::optional<int> max_iter;  ///< unset: each stage's own limit (untangle 200, shape 100)
   double tol = 1e-5, margin = 0.05;
+  double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
   int* threads = nullptr;
 };
 
@@ -63,6 +65,7 @@ void run(const Args& a) {
   if (!a.volume.empty() && !a.slide) throw Error("smooth: --volume is only used with --boundary slide");
   if (!a.volume.empty() && !a.iso) throw Error("smooth: --volume needs --iso V");
   if (a.volume.empty() && a.iso) throw Error("smooth: --iso is only used with --volume");
+  if (a.surface_band > 0 && !a.slide) throw Error("smooth: --surface-band releases sliding vertices; it needs --boundary slide");
   HexMesh mesh = load_mesh(a.in, a.skip_non_hex);
   // With --boundary slide the boundary vertices move on the input's own boundary surface, or
   // on the isosurface of --volume, except those on sharp feature edges (and, on an isosurface,
@@ -122,6 +125,16 @@ void run(const Args& a) {
   o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
   o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
   report.update(run_optimisation(mesh, fixed, o));
+  double band = 0;
+  if (surface && a.surface_band > 0) {
+    // The band in the boundary's own unit: its mean edge length.
+    double sum = 0;
+    std::size_t edges = 0;
+    for (const Quad& q : boundary_quads(mesh))
+      for (int i = 0; i < 4; ++i, ++edges) sum += (mesh.points[q[(i + 1) % 4]] - mesh.points[q[i]]).norm();
+    band = edges ? a.surface_band * sum / static_cast<double>(edges) : 0;
+    report["rounds"] = release_rounds(mesh, *surface, band, o);
+  }
 
   const MetricSummary after = sj_summary(mesh);
   print_quality("after", after);
@@ -131,12 +144,19 @@ void run(const Args& a) {
   if (surface) {
     // A self-check in the report: how far the sliding vertices are from the target surface
     // (a distance for the input's boundary, |f - iso| / range for an isosurface).
-    double far = 0;
-    for (Index v = 0; v < mesh.num_vertices(); ++v)
+    double far = 0, off = 0;
+    for (Index v = 0; v < mesh.num_vertices(); ++v) {
       if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(v, mesh.points[v]));
+      if (surface->role(v) == BoundarySurface::Role::loose) off = std::max(off, surface->offset(v, mesh.points[v]));
+    }
     report["boundary"] = {{"mode", "slide"},       {"sliding", surface->num_sliding()},
                           {"pinned", surface->num_pinned()}, {"feature_angle", a.feature_angle},
-                          {"target", field ? "isosurface" : "input boundary"}};
+                          {"target", field ? "isosurface" : "input boundary"},
+                          {"band", band},          {"loose", surface->num_loose()},
+                          {"max_loose_distance", off}};
+    if (surface->num_loose() > 0)
+      fmt::print("boundary: {} vertices released within {:.3g} of their surface (band {:.3g})\n", surface->num_loose(),
+                 off, band);
     if (field) {
       report["boundary"]["max_relative_level"] = far;
       fmt::print("boundary: sliding vertices at most {:.3g} x range from the isosurface (|f - iso| / range)\n", far);
@@ -181,6 +201,10 @@ void register_smooth(CLI::App& app) {
   cmd->add_option("--feature-angle", a->feature_angle,
                   "With --boundary slide: boundary edges bent by more than this many degrees are features (default 30)")
       ->check(CLI::Range(0.0, 180.0));
+  cmd->add_option("--surface-band", a->surface_band,
+                  "With --boundary slide: release the boundary vertices of hexes still below 0.2 into a band of this "
+                  "many mean boundary edge lengths about their surface and optimise again (default 0: off)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--max-iter", a->max_iter,
                   "Iteration limit of the untangler and the shape stage (default 200 and 100; the untangler "
                   "usually stops earlier, when it stalls)")->check(CLI::NonNegativeNumber);

@@ -130,6 +130,58 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
   return j;
 }
 
+nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& o) {
+  nlohmann::json released = nlohmann::json::array();
+  // Where the surface itself leaves no valid or good place for the hexes at it (knife edges
+  // one voxel thick), its vertices of those hexes are released into the band and the whole
+  // sequence runs again around them: on the hexes within kRings hex rings of those below
+  // 0.2, the rest held (the rest has converged already; re-running all of it doubled the
+  // stage's time). Two more rounds catch what is still below 0.2, reaching one ring of hexes
+  // further for the release (an inner hex squeezed between sheets has no boundary vertex).
+  constexpr int kRings = 3;
+  const Incidence inc = vertex_hexes(mesh);
+  for (int round = 1; round <= 3; ++round) {
+    const std::vector<double> sj = scaled_jacobians(mesh);
+    const auto low = [&](Index h) { return sj[h] < 0.2 || is_degenerate(sj[h]); };
+    std::vector<Index> candidates;
+    const auto add = [&](Index h) {
+      for (Index v : mesh.hexes[h])
+        if (surface.role(v) != BoundarySurface::Role::interior) candidates.push_back(v);
+    };
+    for (Index h = 0; h < mesh.num_hexes(); ++h) {
+      if (!low(h)) continue;
+      add(h);
+      if (round > 1)
+        for (Index v : mesh.hexes[h])
+          for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) add(inc.ids[k]);
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    const std::size_t n = surface.loosen(mesh, candidates, band);
+    if (n == 0) break;
+    fmt::print("boundary: {} vertices of hexes below 0.2 released into a band of {:.3g} about their surface; "
+               "optimising again\n", n, band);
+    std::vector<std::uint8_t> near(mesh.hexes.size(), 0), held(mesh.points.size(), 1);
+    for (Index h = 0; h < mesh.num_hexes(); ++h) near[h] = low(h);
+    for (int ring = 0; ring <= kRings; ++ring) {
+      std::fill(held.begin(), held.end(), 1);
+      for (Index h = 0; h < mesh.num_hexes(); ++h)
+        if (near[h])
+          for (Index v : mesh.hexes[h]) held[v] = 0;
+      if (ring == kRings) break;
+      for (Index v = 0; v < mesh.num_vertices(); ++v)
+        if (!held[v])
+          for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) near[inc.ids[k]] = 1;
+    }
+    const std::vector<std::uint8_t> pinned = surface.fixed_mask();
+    for (std::size_t v = 0; v < held.size(); ++v) held[v] = held[v] || pinned[v];
+    nlohmann::json again = run_optimisation(mesh, held, o);
+    again["released"] = n;
+    released.push_back(again);
+  }
+  return released;
+}
+
 nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide,
                               std::vector<std::uint8_t>* released_mask) {
   std::unique_ptr<BoundarySurface> surface;
@@ -167,55 +219,8 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
     o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
   }
   nlohmann::json j = run_optimisation(mesh, fixed, o);
-  nlohmann::json released = nlohmann::json::array();
-  if (surface && slide.band > 0) {
-    // Where the surface itself leaves no valid or good place for the hexes at it (knife edges
-    // one voxel thick), its vertices of those hexes are released into the band and the whole
-    // sequence runs again around them: on the hexes within kRings hex rings of those below
-    // 0.2, the rest held (the rest has converged already; re-running all of it doubled the
-    // stage's time). Two more rounds catch what is still below 0.2, reaching one ring of hexes
-    // further for the release (an inner hex squeezed between sheets has no boundary vertex).
-    constexpr int kRings = 3;
-    const Incidence inc = vertex_hexes(mesh);
-    for (int round = 1; round <= 3; ++round) {
-      const std::vector<double> sj = scaled_jacobians(mesh);
-      std::vector<Index> candidates;
-      const auto add = [&](Index h) {
-        for (Index v : mesh.hexes[h])
-          if (surface->role(v) != BoundarySurface::Role::interior) candidates.push_back(v);
-      };
-      for (Index h = 0; h < mesh.num_hexes(); ++h) {
-        if (!(sj[h] < 0.2 || is_degenerate(sj[h]))) continue;
-        add(h);
-        if (round > 1)
-          for (Index v : mesh.hexes[h])
-            for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) add(inc.ids[k]);
-      }
-      std::sort(candidates.begin(), candidates.end());
-      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-      const std::size_t n = surface->loosen(mesh, candidates, slide.band);
-      if (n == 0) break;
-      fmt::print("boundary: {} vertices of hexes below 0.2 released into a band of {:.3g} about their surface; "
-                 "optimising again\n", n, slide.band);
-      std::vector<std::uint8_t> near(mesh.hexes.size(), 0), held(mesh.points.size(), 1);
-      for (Index h = 0; h < mesh.num_hexes(); ++h) near[h] = sj[h] < 0.2 || is_degenerate(sj[h]);
-      for (int ring = 0; ring <= kRings; ++ring) {
-        std::fill(held.begin(), held.end(), 1);
-        for (Index h = 0; h < mesh.num_hexes(); ++h)
-          if (near[h])
-            for (Index v : mesh.hexes[h]) held[v] = 0;
-        if (ring == kRings) break;
-        for (Index v = 0; v < mesh.num_vertices(); ++v)
-          if (!held[v])
-            for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) near[inc.ids[k]] = 1;
-      }
-      const std::vector<std::uint8_t> pinned = surface->fixed_mask();
-      for (std::size_t v = 0; v < held.size(); ++v) held[v] = held[v] || pinned[v];
-      nlohmann::json again = run_optimisation(mesh, held, o);
-      again["released"] = n;
-      released.push_back(again);
-    }
-  }
+  const nlohmann::json released =
+      surface && slide.band > 0 ? release_rounds(mesh, *surface, slide.band, o) : nlohmann::json::array();
   if (surface) {
     double far = 0, off = 0;
     for (Index v = 0; v < mesh.num_vertices(); ++v) {

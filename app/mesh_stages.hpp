@@ -48,6 +48,12 @@ ProgressCallback progress_printer(std::FILE* out);
 /// reason; shape; worst). Returns the JSON facts ("untangle", "shape", "worst").
 nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options);
 
+/// After a first run_optimisation() with `surface`: up to three rounds that release the
+/// boundary vertices of the hexes still below 0.2 into a band of half-width `band` (world
+/// units) about their surface (BoundarySurface::loosen) and optimise again within 3 hex rings
+/// of those hexes. Returns each round's JSON facts (with "released": vertices released).
+nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& options);
+
 /// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
 /// (`--boundary slide`): each boundary vertex on its own surface, the one `vertex_place` names
 /// among region->surfaces. A vertex on one face of the domain box (an --outer box, or the

@@ -126,6 +126,21 @@ def sheets(isohex, mesh, json_file, reuse):
         return json.load(f)
 
 
+def prepared_cases(a):
+    """The cases --only selects, each with its work folder (made), the {work} formatter and its
+    `isohex mesh` arguments, after running its volume preparation."""
+    for name, prep, mesh_args in CASES:
+        if a.only and name not in a.only:
+            continue
+        work = os.path.join(a.work, name.replace(" ", "_"))
+        os.makedirs(work, exist_ok=True)
+        f = lambda s, work=work: s.format(work=work)
+        if prep:
+            out = f(prep[prep.index("-o") + 1])
+            run([a.isohex] + [f(x) for x in prep], out + ".time", out, a.reuse)
+        yield name, work, f, mesh_args
+
+
 def pipeline(a):
     """`isohex mesh` with its defaults on every case: its own stage table, what the band released,
     and the sheets after pillowing (from its report)."""
@@ -133,15 +148,7 @@ def pipeline(a):
           "boundary captured by one sheet, hexes with ≥ 2 boundary faces | released vertices (max distance) | "
           "parts dropped | time |")
     print("|---|---|---|---|---|--:|--:|")
-    for name, prep, mesh_args in CASES:
-        if a.only and name not in a.only:
-            continue
-        work = os.path.join(a.work, name.replace(" ", "_"))
-        os.makedirs(work, exist_ok=True)
-        f = lambda s: s.format(work=work)
-        if prep:
-            out = f(prep[prep.index("-o") + 1])
-            run([a.isohex] + [f(x) for x in prep], out + ".time", out, a.reuse)
+    for name, work, f, mesh_args in prepared_cases(a):
         P = os.path.join(work, "pipeline.vtu")
         t = run([a.isohex, "mesh"] + [f(x) for x in mesh_args] + ["-o", P, "--json", P + ".json"], P + ".time", P,
                 a.reuse, ok=(0, 1))
@@ -182,15 +189,7 @@ def main():
     # stage here is extraction + surface smoothing only.
     help_text = subprocess.run([a.isohex, "mesh", "--help"], stdout=subprocess.PIPE, text=True).stdout
     stage_flags = [flag for flag in ("--no-pillow", "--no-smooth") if flag in help_text]
-    for name, prep, mesh_args in CASES:
-        if a.only and name not in a.only:
-            continue
-        work = os.path.join(a.work, name.replace(" ", "_"))
-        os.makedirs(work, exist_ok=True)
-        f = lambda s: s.format(work=work)
-        if prep:
-            out = f(prep[prep.index("-o") + 1])
-            run([a.isohex] + [f(x) for x in prep], out + ".time", out, a.reuse)
+    for name, work, f, mesh_args in prepared_cases(a):
         A, B, C = (os.path.join(work, x) for x in ("a.vtu", "b.vtu", "c.vtu"))
         t_mesh = run([a.isohex, "mesh"] + [f(x) for x in mesh_args] + stage_flags + ["-o", A, "--json", A + ".json"],
                      A + ".time", A, a.reuse)

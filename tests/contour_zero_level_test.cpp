@@ -7,7 +7,6 @@
 #include "isohex/mesh/topology.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/quality/hex_quality.hpp"
-#include "isohex/volume/volume_io.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -174,16 +173,7 @@ TEST(ContourZeroLevel, ProjectionFallbacksStayInsideTheirCells) {
     std::size_t max_quads;
   };
   for (const Case& c : {Case{"cthead_256x256x113_int16be.raw", 600, 4, 0}, Case{"HeadMRVolume.mhd", 40, 4, 6}}) {
-    VolumeReadOptions opt;
-    if (std::string(c.file).ends_with(".raw")) {
-      RawLayout raw;
-      raw.dims = {256, 256, 113};
-      raw.type = ScalarType::i16;
-      raw.big_endian = true;
-      raw.spacing = Vec3(1, 1, 2);
-      opt.raw = raw;
-    }
-    const Volume v = read_volume(test::shared_data(std::string("volumes/") + c.file), opt);
+    const Volume v = test::shared_volume(c.file);
     RegionSpec spec;
     spec.isovalue = c.iso;
     const Region region = make_region(v, spec);

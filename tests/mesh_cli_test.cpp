@@ -197,13 +197,7 @@ TEST(MeshCli, SurfaceBandReleasesKnifeEdgesWithinTheBand) {
   // Independently: the distance from each boundary vertex of the written mesh to the
   // isosurface, as |f − 1150| / |∇f| of the trilinear field, at most the band (first order).
   const HexMesh m = io::read_mesh(dir / "band.vtu");
-  VolumeReadOptions ro;
-  RawLayout raw;
-  raw.dims = {64, 64, 93};
-  raw.type = ScalarType::i16;
-  raw.spacing = Vec3(3.2, 3.2, 1.5);
-  ro.raw = raw;
-  const Volume v = read_volume(isohex::test::shared_data("volumes/headsq_64x64x93_int16le.raw"), ro);
+  const Volume v = isohex::test::shared_volume("headsq_64x64x93_int16le.raw");
   const IsoField f(v, 1150, Inside::above);
   const auto boundary = boundary_vertex_mask(m);
   const Vec3 hi(63 * 3.2, 63 * 3.2, 92 * 1.5);
@@ -257,4 +251,32 @@ TEST(MeshCli, SpecksBelowTheMinimumComponentAreDroppedByDefault) {
   EXPECT_EQ(ca.num_boundary_components, 1u);
   EXPECT_EQ(cb.num_boundary_components, 2u);
   EXPECT_EQ(cb.num_boundary_quads, ca.num_boundary_quads + 6);
+}
+
+// `isohex smooth --boundary slide --volume V --surface-band F`: the same release as `isohex
+// mesh`, F in mean boundary edge lengths. On bucky (extraction and pillowing by `isohex mesh
+// --no-smooth`), sliding alone leaves hexes below 0.2 and inverted; with the band, fewer, and
+// every released vertex within the band.
+TEST(MeshCli, SmoothReleasesIntoTheBandToo) {
+  ISOHEX_REQUIRE_SHARED_DATA();
+  const auto dir = scratch_dir();
+  std::string out;
+  ASSERT_EQ(run_cli("volume convert " + q(isohex::test::shared_data("volumes/bucky_32x32x32_uint8.raw")) + " " +
+                        q(dir / "b.nrrd") + " --dims 32 32 32 --type u8", &out), 0) << out;
+  ASSERT_EQ(run_cli("mesh " + q(dir / "b.nrrd") + " --iso 51 --no-smooth -o " + q(dir / "p.vtu"), &out), 0) << out;
+  const std::string smooth = "smooth " + q(dir / "p.vtu") + " --untangle --boundary slide --volume " + q(dir / "b.nrrd") +
+                             " --iso 51 ";
+  ASSERT_LE(run_cli(smooth + "-o " + q(dir / "s0.vtu") + " --json " + q(dir / "s0.json"), &out), 1) << out;
+  ASSERT_EQ(run_cli(smooth + "--surface-band 0.3 -o " + q(dir / "s1.vtu") + " --json " + q(dir / "s1.json"), &out), 0) << out;
+  const auto s0 = nlohmann::json::parse(io::read_file(dir / "s0.json"));
+  const auto s1 = nlohmann::json::parse(io::read_file(dir / "s1.json"));
+  EXPECT_EQ(s0["boundary"]["loose"], 0);
+  EXPECT_GT(s0["after"]["below_0.2"].get<int>(), 50);
+  EXPECT_LT(s1["after"]["below_0.2"].get<int>(), s0["after"]["below_0.2"].get<int>() / 4);
+  EXPECT_EQ(s1["after"]["inverted"], 0);
+  EXPECT_GT(s1["boundary"]["loose"].get<int>(), 0);
+  EXPECT_LE(s1["boundary"]["max_loose_distance"].get<double>(), s1["boundary"]["band"].get<double>() * (1 + 1e-6));
+  EXPECT_GT(s1["boundary"]["band"].get<double>(), 0.2);  // 0.3 of a mean edge of about a voxel
+  EXPECT_NE(run_cli("smooth " + q(dir / "p.vtu") + " --surface-band 0.3 -o " + q(dir / "x.vtu"), &out), 0);
+  EXPECT_NE(out.find("needs --boundary slide"), std::string::npos) << out;
 }

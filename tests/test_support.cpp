@@ -1,6 +1,7 @@
 #include "test_support.hpp"
 
 #include "isohex/mesh/generate.hpp"
+#include "isohex/volume/volume_io.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,6 +17,28 @@ bool have_shared_data() { return fs::is_directory(ISOHEX_SHARED_DATA); }
 
 fs::path shared_data(const std::string& rel) {
   return fs::path(ISOHEX_SHARED_DATA) / rel;
+}
+
+Volume shared_volume(const std::string& file) {
+  VolumeReadOptions opt;
+  RawLayout raw;
+  if (file == "cthead_256x256x113_int16be.raw") {
+    raw.dims = {256, 256, 113};
+    raw.type = ScalarType::i16;
+    raw.big_endian = true;
+    raw.spacing = Vec3(1, 1, 2);  // not stated in the source; the project's assumption
+    opt.raw = raw;
+  } else if (file == "headsq_64x64x93_int16le.raw") {
+    raw.dims = {64, 64, 93};
+    raw.type = ScalarType::i16;
+    raw.spacing = Vec3(3.2, 3.2, 1.5);
+    opt.raw = raw;
+  } else if (file == "bucky_32x32x32_uint8.raw") {
+    raw.dims = {32, 32, 32};
+    raw.type = ScalarType::u8;
+    opt.raw = raw;
+  }
+  return read_volume(shared_data("volumes/" + file), opt);
 }
 
 fs::path scratch_dir() {

@@ -2,6 +2,7 @@
 // Helpers shared by the tests: data paths, a scratch folder, generated meshes, running the CLI.
 
 #include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/volume/volume.hpp"
 
 #include <filesystem>
 #include <string>
@@ -12,6 +13,9 @@ namespace isohex::test {
 std::filesystem::path shared_data(const std::string& rel);
 /// True when the shared data folder exists.
 bool have_shared_data();
+/// `../shared/data/volumes/<file>`, read with the raw layout SOURCES.md gives for the raw ones
+/// (cthead, headsq, bucky); other formats describe themselves.
+Volume shared_volume(const std::string& file);
 /// A fresh, empty scratch folder named after the running test.
 std::filesystem::path scratch_dir();
 /// An nx*ny*nz grid of unit-spaced hexes (spacing h), vertices numbered x fastest.
