@@ -115,6 +115,13 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
   for (Index v : vertices) {
     if (v < 0 || static_cast<std::size_t>(v) >= role_.size()) continue;
     if (role_[v] == static_cast<std::uint8_t>(Role::pinned)) {
+      if (surfaces_.empty()) {
+        // On the input's own boundary triangles: a feature vertex, released about them.
+        --pinned_;
+        role_[v] = static_cast<std::uint8_t>(Role::loose);
+        ++n;
+        continue;
+      }
       // A rim vertex: about the first isosurface it is on (box faces and spheres are exact).
       std::size_t k = 0;
       while (k < surfaces_.size() && !(surfaces_[k].field() && surfaces_[k].on(mesh.points[v]))) ++k;
