@@ -10,6 +10,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/summary.hpp"
+#include "isohex/volume/hex_selection.hpp"
 #include "isohex/volume/volume_io.hpp"
 
 #include <fmt/format.h>
@@ -30,6 +31,7 @@ namespace {
 struct Args {
   std::string in, out, json;
   std::string volume, inside = "above";  ///< --boundary slide on the isosurface of a volume
+  std::string fixed_ids;                 ///< --fixed-ids FILE: the fixed vertices, listed
   std::optional<double> iso;
   bool untangle = false, skip_non_hex = false, no_worst = false, slide = false;
   double feature_angle = 30;
@@ -65,6 +67,8 @@ void run(const Args& a) {
   if (!a.volume.empty() && !a.slide) throw Error("smooth: --volume is only used with --boundary slide");
   if (!a.volume.empty() && !a.iso) throw Error("smooth: --volume needs --iso V");
   if (a.volume.empty() && a.iso) throw Error("smooth: --iso is only used with --volume");
+  if (!a.fixed_ids.empty() && (a.slide || a.fixed != FixedVertices::boundary))
+    throw Error("smooth: --fixed-ids gives the fixed vertices itself; it cannot be combined with --boundary slide or --fixed");
   if (a.surface_band > 0 && !a.slide) throw Error("smooth: --surface-band releases sliding vertices; it needs --boundary slide");
   HexMesh mesh = load_mesh(a.in, a.skip_non_hex);
   // With --boundary slide the boundary vertices move on the input's own boundary surface, or
@@ -80,7 +84,10 @@ void run(const Args& a) {
   } else if (a.slide) {
     surface = std::make_unique<BoundarySurface>(mesh, a.feature_angle);
   }
-  const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(mesh, a.fixed);
+  const std::vector<std::uint8_t> fixed =
+      surface              ? surface->fixed_mask()
+      : a.fixed_ids.empty() ? fixed_mask(mesh, a.fixed)
+                            : read_id_list(a.fixed_ids, mesh.points.size(), "vertex", "smooth --fixed-ids");
   std::size_t n_fixed = 0;
   for (std::uint8_t f : fixed) n_fixed += f != 0;
   fmt::print("{}: {} hexes, {} vertices, {} fixed\n", a.in, mesh.num_hexes(), mesh.num_vertices(), n_fixed);
@@ -187,6 +194,8 @@ void register_smooth(CLI::App& app) {
       {"boundary", FixedVertices::boundary}, {"file", FixedVertices::file}, {"none", FixedVertices::none}};
   cmd->add_option("--fixed", a->fixed, "Fixed vertices: boundary (default), file (the mesh's 'fixed' flags), none")
       ->transform(CLI::CheckedTransformer(fixed_names, CLI::ignore_case));
+  cmd->add_option("--fixed-ids", a->fixed_ids,
+                  "Fixed vertices from a file instead: one vertex id per line ('#' comments); every other vertex moves");
   const std::map<std::string, bool> boundary_names{{"fixed", false}, {"slide", true}};
   cmd->add_option("--boundary", a->slide,
                   "Boundary vertices: fixed (default) or slide (move on the input's boundary surface, or on the "

@@ -597,3 +597,47 @@ TEST(OptimizeSlide, BandOnTheInputBoundaryUntanglesTheEcrDragon) {
   EXPECT_LE(far, band * (1 + 1e-6));
   EXPECT_LE(off, loose);
 }
+
+// `isohex smooth --fixed-ids FILE`: the listed vertices are held bit for bit, the others move
+// (here: all but one boundary vertex listed, so that one moves off its place); a bad line is
+// refused with the file and line, and nothing is written.
+TEST(OptimizeSlide, FixedIdsFromAFile) {
+  const auto dir = scratch_dir();
+  const HexMesh in = slid_box(4, 0.8, 7);
+  io::write_mesh(dir / "in.vtk", in);
+  const auto boundary = boundary_vertex_mask(in);
+  Index free_one = -1;
+  {
+    std::ofstream ids(dir / "ids.txt");
+    ids << "# boundary vertices but one\n";
+    for (Index v = 0; v < in.num_vertices(); ++v) {
+      if (!boundary[v]) continue;
+      if (free_one < 0 && in.points[v].x() > 0 && in.points[v].x() < 1 && in.points[v].y() > 0 && in.points[v].y() < 1) {
+        free_one = v;  // an inner vertex of the face z = 0 or 1
+        continue;
+      }
+      ids << v << "\n";
+    }
+  }
+  ASSERT_GE(free_one, 0);
+  std::string out;
+  ASSERT_EQ(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "out.vtk") + " --fixed-ids " +
+                        quote(dir / "ids.txt"), &out),
+            0)
+      << out;
+  const HexMesh res = io::read_mesh(dir / "out.vtk");
+  std::size_t interior_moved = 0;
+  for (Index v = 0; v < in.num_vertices(); ++v) {
+    if (boundary[v] && v != free_one) ASSERT_EQ(res.points[v], in.points[v]) << v;
+    if (!boundary[v]) interior_moved += res.points[v] != in.points[v];
+  }
+  EXPECT_NE(res.points[free_one], in.points[free_one]);
+  EXPECT_GT(interior_moved, 0u);
+  { std::ofstream bad(dir / "bad.txt"); bad << "0\n1\n99999\n"; }
+  EXPECT_NE(run_cli("smooth " + quote(dir / "in.vtk") + " -o " + quote(dir / "x.vtk") + " --fixed-ids " +
+                        quote(dir / "bad.txt"), &out),
+            0);
+  EXPECT_NE(out.find("line 3"), std::string::npos) << out;
+  EXPECT_NE(out.find("out of range"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.vtk"));
+}

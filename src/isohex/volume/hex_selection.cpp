@@ -26,25 +26,30 @@ std::string_view trim(std::string_view s) {
 }
 
 std::vector<std::uint8_t> from_ids_file(const HexMesh& mesh, const std::string& file, std::string_view context) {
+  return read_id_list(file, mesh.hexes.size(), "hex", context);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> read_id_list(const std::string& file, std::size_t count, std::string_view noun,
+                                       std::string_view context) {
   std::ifstream in(file);
   if (!in) throw Error(fmt::format("{}: cannot open ids file '{}'", context, file));
-  std::vector<std::uint8_t> set(mesh.hexes.size(), 0);
+  std::vector<std::uint8_t> set(count, 0);
   std::string line;
   for (long line_no = 1; std::getline(in, line); ++line_no) {
     const std::string_view t = trim(line);
     if (t.empty() || t.front() == '#') continue;
     long long id = 0;
     if (!parse_int(t, id))
-      throw Error(fmt::format("{}: {}, line {}: '{}' is not a hex id", context, file, line_no, t));
-    if (id < 0 || id >= mesh.num_hexes())
-      throw Error(fmt::format("{}: {}, line {}: hex id {} is out of range [0, {})", context, file, line_no,
-                              id, mesh.num_hexes()));
+      throw Error(fmt::format("{}: {}, line {}: '{}' is not a {} id", context, file, line_no, t, noun));
+    if (id < 0 || static_cast<unsigned long long>(id) >= count)
+      throw Error(fmt::format("{}: {}, line {}: {} id {} is out of range [0, {})", context, file, line_no, noun, id,
+                              count));
     set[static_cast<std::size_t>(id)] = 1;
   }
   return set;
 }
-
-}  // namespace
 
 std::vector<std::uint8_t> select_hexes(const HexMesh& mesh, const std::string& spec, std::string_view context,
                                        std::string_view all_keyword) {

@@ -24,4 +24,10 @@ namespace isohex {
 std::vector<std::uint8_t> select_hexes(const HexMesh& mesh, const std::string& spec, std::string_view context,
                                        std::string_view all_keyword = "all");
 
+/// Flags (1 = listed) for `count` ids read from `file`: one id per line, blank lines and lines
+/// starting with '#' ignored. Throws isohex::Error, prefixed with `context`, naming the file
+/// and line of a bad or out-of-range id (`noun`: "hex", "vertex").
+std::vector<std::uint8_t> read_id_list(const std::string& file, std::size_t count, std::string_view noun,
+                                       std::string_view context);
+
 }  // namespace isohex
