@@ -151,11 +151,7 @@ void run(const Args& a) {
   if (surface) {
     // A self-check in the report: how far the sliding vertices are from the target surface
     // (a distance for the input's boundary, |f - iso| / range for an isosurface).
-    double far = 0, off = 0;
-    for (Index v = 0; v < mesh.num_vertices(); ++v) {
-      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(v, mesh.points[v]));
-      if (surface->role(v) == BoundarySurface::Role::loose) off = std::max(off, surface->offset(v, mesh.points[v]));
-    }
+    const auto [far, off] = surface->fit(mesh);
     report["boundary"] = {{"mode", "slide"},       {"sliding", surface->num_sliding()},
                           {"pinned", surface->num_pinned()}, {"feature_angle", a.feature_angle},
                           {"target", field ? "isosurface" : "input boundary"},

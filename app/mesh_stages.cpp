@@ -142,14 +142,13 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
   const Incidence inc = vertex_hexes(mesh);
   for (int round = 1; round <= 3; ++round) {
     const std::vector<double> sj = scaled_jacobians(mesh);
-    const auto low = [&](Index h) { return sj[h] < 0.2 || is_degenerate(sj[h]); };
     std::vector<Index> candidates;
     const auto add = [&](Index h) {
       for (Index v : mesh.hexes[h])
         if (surface.role(v) != BoundarySurface::Role::interior) candidates.push_back(v);
     };
     for (Index h = 0; h < mesh.num_hexes(); ++h) {
-      if (!low(h)) continue;
+      if (!(sj[h] < kQuestionableSJ || is_degenerate(sj[h]))) continue;
       add(h);
       if (round > 1)
         for (Index v : mesh.hexes[h])
@@ -161,18 +160,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
     if (n == 0) break;
     fmt::print("boundary: {} vertices of hexes below 0.2 released into a band of {:.3g} about their surface; "
                "optimising again\n", n, band);
-    std::vector<std::uint8_t> near(mesh.hexes.size(), 0), held(mesh.points.size(), 1);
-    for (Index h = 0; h < mesh.num_hexes(); ++h) near[h] = low(h);
-    for (int ring = 0; ring <= kRings; ++ring) {
-      std::fill(held.begin(), held.end(), 1);
-      for (Index h = 0; h < mesh.num_hexes(); ++h)
-        if (near[h])
-          for (Index v : mesh.hexes[h]) held[v] = 0;
-      if (ring == kRings) break;
-      for (Index v = 0; v < mesh.num_vertices(); ++v)
-        if (!held[v])
-          for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) near[inc.ids[k]] = 1;
-    }
+    std::vector<std::uint8_t> held = frozen_outside(mesh, inc, sj, kQuestionableSJ, kRings);
     const std::vector<std::uint8_t> pinned = surface.fixed_mask();
     for (std::size_t v = 0; v < held.size(); ++v) held[v] = held[v] || pinned[v];
     nlohmann::json again = run_optimisation(mesh, held, o);
@@ -222,11 +210,7 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
   const nlohmann::json released =
       surface && slide.band > 0 ? release_rounds(mesh, *surface, slide.band, o) : nlohmann::json::array();
   if (surface) {
-    double far = 0, off = 0;
-    for (Index v = 0; v < mesh.num_vertices(); ++v) {
-      if (surface->role(v) == BoundarySurface::Role::slides) far = std::max(far, surface->deviation(v, mesh.points[v]));
-      if (surface->role(v) == BoundarySurface::Role::loose) off = std::max(off, surface->offset(v, mesh.points[v]));
-    }
+    const auto [far, off] = surface->fit(mesh);
     nlohmann::json per = nlohmann::json::object();
     for (std::size_t k = 0; k < surface->surfaces().size(); ++k)
       if (const std::size_t n = surface->num_sliding_on(k); n > 0) per[surface->surfaces()[k].describe()] = n;

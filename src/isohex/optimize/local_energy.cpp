@@ -192,9 +192,8 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   // boundary or an isosurface) where it is and is put back on that surface (on the same side:
   // the facing test), so the energy is compared at points of the surface only. A step that
   // cannot be put back is refused.
+  // (A loose vertex steps freely and is clamped back into the band about its surface.)
   const bool slides = params.surface && params.surface->role(v) == BoundarySurface::Role::slides;
-  // A loose vertex steps freely and is clamped back into the band about its surface.
-  const bool loose = params.surface && params.surface->role(v) == BoundarySurface::Role::loose;
   Vec3 n = Vec3::Zero();
   if (slides) {
     if (!params.surface->tangent_normal(v, m.x, n)) return m;
@@ -207,8 +206,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   double t = 1;
   for (int i = 0; i < 30; ++i, t *= 0.5) {
     Vec3 x = m.x + t * d;
-    if (slides && !params.surface->reproject(v, x, n, len)) continue;
-    if (loose && !params.surface->band_clamp(v, x, len)) continue;
+    if (params.surface && !params.surface->put_back(v, x, n, len)) continue;
     const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
     if (e < e0 && e <= e0 + 1e-4 * t * slope) {
       m.x = x;

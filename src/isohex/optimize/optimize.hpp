@@ -43,6 +43,7 @@
 /// (a step that cannot be put back on the isosurface is refused).
 
 #include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/mesh/topology.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -80,6 +81,12 @@ struct IterationReport {
   std::size_t inverted = 0; ///< hexes with scaled Jacobian <= 0
 };
 using ProgressCallback = std::function<void(const IterationReport&)>;
+
+/// 1 for every vertex outside `rings` hex-rings of the hexes whose scaled Jacobian `sj` is
+/// below `margin` (or degenerate; hexes flagged in `skip` left out), 0 within: the vertices a
+/// local pass holds (the untangler; `isohex mesh`'s band rounds).
+std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& sj,
+                                         double margin, int rings, const std::vector<std::uint8_t>* skip = nullptr);
 
 /// Options of the untangler.
 struct UntangleOptions {

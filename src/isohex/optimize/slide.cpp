@@ -115,18 +115,14 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
   for (Index v : vertices) {
     if (v < 0 || static_cast<std::size_t>(v) >= role_.size()) continue;
     if (role_[v] == static_cast<std::uint8_t>(Role::pinned)) {
-      if (surfaces_.empty()) {
-        // On the input's own boundary triangles: a feature vertex, released about them.
-        --pinned_;
-        role_[v] = static_cast<std::uint8_t>(Role::loose);
-        ++n;
-        continue;
+      // On the input's own triangles, a feature vertex is released about them; on level sets a
+      // rim vertex about the first isosurface it is on (box faces and spheres are exact).
+      if (!surfaces_.empty()) {
+        std::size_t k = 0;
+        while (k < surfaces_.size() && !(surfaces_[k].field() && surfaces_[k].on(mesh.points[v]))) ++k;
+        if (k == surfaces_.size()) continue;
+        target_[v] = static_cast<std::int8_t>(k);
       }
-      // A rim vertex: about the first isosurface it is on (box faces and spheres are exact).
-      std::size_t k = 0;
-      while (k < surfaces_.size() && !(surfaces_[k].field() && surfaces_[k].on(mesh.points[v]))) ++k;
-      if (k == surfaces_.size()) continue;
-      target_[v] = static_cast<std::int8_t>(k);
       --pinned_;
     } else if (role_[v] == static_cast<std::uint8_t>(Role::slides)) {
       --sliding_;
@@ -172,6 +168,23 @@ bool BoundarySurface::band_clamp(Index v, Vec3& x, double len) const {
     x = foot + d * (band_ / dn);
   }
   return false;
+}
+
+bool BoundarySurface::put_back(Index v, Vec3& x, const Vec3& n, double len) const {
+  switch (role(v)) {
+    case Role::slides: return reproject(v, x, n, len);
+    case Role::loose: return band_clamp(v, x, len);
+    default: return true;
+  }
+}
+
+BoundarySurface::Fit BoundarySurface::fit(const HexMesh& mesh) const {
+  Fit f;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (role(v) == Role::slides) f.max_deviation = std::max(f.max_deviation, deviation(v, mesh.points[v]));
+    if (role(v) == Role::loose) f.max_offset = std::max(f.max_offset, offset(v, mesh.points[v]));
+  }
+  return f;
 }
 
 double BoundarySurface::offset(Index v, const Vec3& x) const {

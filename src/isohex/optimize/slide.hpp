@@ -64,13 +64,14 @@ class BoundarySurface {
   /// How far x is from v's target: the distance to the triangles, or |L| / scale.
   [[nodiscard]] double deviation(Index v, const Vec3& x) const;
 
-  /// Releases the sliding vertices among `vertices` (others are ignored) into a band of
+  /// Releases the sliding vertices among `vertices` (interior ones are ignored) into a band of
   /// half-width `band` (world units) about their target: they step freely in space and are
   /// clamped back into the band (band_clamp). For a boundary that, kept exactly on the
   /// isosurface, leaves elements that no interior placement can make valid: a knife edge
   /// one voxel thick, whose quads face opposite ways at a vertex. Returns how many were released.
-  /// Pinned vertices that lie on an isosurface (a rim, where it meets the domain box) are
-  /// released about that isosurface too.
+  /// Pinned vertices are released too where they have a surface to keep near: about the
+  /// input's triangles (feature vertices), or about the isosurface they lie on (a rim, where it
+  /// meets the domain box).
   std::size_t loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band);
   /// The box loose vertices must stay in (the domain: a band must not carry them out of it).
   void set_domain(const Aabb& box) { domain_ = box; has_domain_ = true; }
@@ -79,9 +80,18 @@ class BoundarySurface {
   /// if x is farther than the band from it, the point at the band's distance towards x. False
   /// when the foot point cannot be found: the step must then be refused.
   bool band_clamp(Index v, Vec3& x, double len) const;
+  /// Puts x, a step of v from a point whose tangent-plane normal is `n`, back where v's role
+  /// allows: reproject() for a sliding vertex, band_clamp() for a loose one, unchanged for the
+  /// others. False: the step must be refused.
+  bool put_back(Index v, Vec3& x, const Vec3& n, double len) const;
   /// The distance from x to its foot point on v's target (world units; 0 if there is none).
   [[nodiscard]] double offset(Index v, const Vec3& x) const;
-  [[nodiscard]] double band() const { return band_; }
+  /// How well `mesh` keeps to the surface: the largest deviation() of a sliding vertex and the
+  /// largest offset() of a loose one.
+  struct Fit {
+    double max_deviation = 0, max_offset = 0;
+  };
+  [[nodiscard]] Fit fit(const HexMesh& mesh) const;
   [[nodiscard]] std::size_t num_loose() const { return loose_; }
   /// True for a vertex that moves with its surface: sliding on it or loose about it.
   [[nodiscard]] bool moves_with_surface(Index v) const {

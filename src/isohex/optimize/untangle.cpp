@@ -29,27 +29,6 @@ std::vector<double> hex_min_det(const HexMesh& mesh, const std::vector<double>& 
   return d;
 }
 
-// The vertices within `rings` hex-rings of the hexes below the margin: the only ones the
-// untangler moves. Far-away vertices sit near their energy minimum already; sweeping them
-// would cost most of the time on a large mesh with a few tangled spots.
-std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& sj,
-                                         double margin, int rings, const std::vector<std::uint8_t>* skip) {
-  std::vector<std::uint8_t> active(mesh.points.size(), 0);
-  for (Index h = 0; h < mesh.num_hexes(); ++h)
-    if ((!skip || !(*skip)[h]) && (sj[h] < margin || is_degenerate(sj[h])))
-      for (Index v : mesh.hexes[h]) active[v] = 1;
-  for (int r = 0; r < rings; ++r) {
-    std::vector<std::uint8_t> grown = active;
-    for (Index v = 0; v < mesh.num_vertices(); ++v)
-      if (active[v])
-        for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
-          for (Index w : mesh.hexes[inc.ids[i]]) grown[w] = 1;
-    active.swap(grown);
-  }
-  for (std::uint8_t& a : active) a = !a;
-  return active;
-}
-
 // opt::sj_stats from scaled Jacobians already computed.
 opt::SJStats stats_of(const std::vector<double>& sj, const std::vector<std::uint8_t>* skip) {
   opt::SJStats s;
@@ -97,6 +76,26 @@ std::size_t lp_rescue(HexMesh& mesh, const VertexColoring& coloring, const Incid
 }
 
 }  // namespace
+
+// Far-away vertices sit near their energy minimum already; sweeping them would cost most of
+// the time on a large mesh with a few tangled spots.
+std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& sj,
+                                         double margin, int rings, const std::vector<std::uint8_t>* skip) {
+  std::vector<std::uint8_t> active(mesh.points.size(), 0);
+  for (Index h = 0; h < mesh.num_hexes(); ++h)
+    if ((!skip || !(*skip)[h]) && (sj[h] < margin || is_degenerate(sj[h])))
+      for (Index v : mesh.hexes[h]) active[v] = 1;
+  for (int r = 0; r < rings; ++r) {
+    std::vector<std::uint8_t> grown = active;
+    for (Index v = 0; v < mesh.num_vertices(); ++v)
+      if (active[v])
+        for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+          for (Index w : mesh.hexes[inc.ids[i]]) grown[w] = 1;
+    active.swap(grown);
+  }
+  for (std::uint8_t& a : active) a = !a;
+  return active;
+}
 
 UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const UntangleOptions& options) {
   UntangleResult res;

@@ -136,8 +136,7 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
       const opt::MaxMin r = opt::max_min_affine(f, w, box);
       if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model: a max–min point
       Vec3 y = slides ? Vec3(x + r.d[0] * t1 + r.d[1] * t2) : Vec3(x + r.d);
-      if (slides && !surface->reproject(v, y, n, len)) continue;  // off the surface: refused
-      if (surface && surface->role(v) == BoundarySurface::Role::loose && !surface->band_clamp(v, y, len)) continue;
+      if (surface && !surface->put_back(v, y, n, len)) continue;  // off the surface (or band): refused
       bool valid = false;
       int below = 0;
       // A negative local minimum may rise while a valid neighbour is inverted on the way;
