@@ -32,7 +32,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; every bad option gives the documented 2 (CLI11's own codes
+    // run from 100 up, one per kind of fault).
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const isohex::Error& e) {
     fmt::print(stderr, "isohex: error: {}\n", e.what());
     return 2;
