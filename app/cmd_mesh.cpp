@@ -20,7 +20,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <limits>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -35,7 +34,7 @@ struct Args {
   std::optional<double> iso, iso2;
   std::string inside = "above", interpolation = "trilinear", region = "inside", outer;
   double cell_size = 0;
-  Index resolution = 0, min_component = 8, min_cavity = 0;
+  Index resolution = 0, min_component = 8;
   // Raw layout (as in `isohex volume info`).
   std::vector<Index> dims;
   std::string type, endian = "little";
@@ -173,7 +172,6 @@ void run(const Args& a) {
     else opt.cell_size = volume.spacing.maxCoeff();  // one voxel
   }
   opt.min_component = a.min_component;
-  opt.min_cavity = a.min_cavity;
   if (terminal) opt.on_stage = [](std::string_view s) { fmt::print("  {}...\n", s), std::fflush(stdout); };
 
   fmt::print("{}: {} x {} x {} points, region {} ", a.shape.empty() ? a.volume : "shape", volume.dims[0],
@@ -248,9 +246,6 @@ void run(const Args& a) {
              "topology kept; {} forced; {} filling {} zero-volume cavities; {} simple at the isovalue); {} cells split\n",
              r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.relocated_points, r.forced_points,
              r.degenerate_points, r.degenerate_components, r.zero_level_points, r.split_cells);
-  if (a.min_cavity > 1)
-    fmt::print("  cavities: {} kept, {} filled ({} grid points) below {} points\n", r.kept_cavities, r.filled_cavities,
-               r.filled_cavity_points, a.min_cavity);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -336,9 +331,6 @@ void run(const Args& a) {
     j["split_cells"] = r.split_cells;
     j["dropped_components"] = r.dropped_components;
     j["dropped_hexes"] = r.dropped_hexes;
-    j["filled_cavities"] = r.filled_cavities;
-    j["filled_cavity_points"] = r.filled_cavity_points;
-    j["kept_cavities"] = r.kept_cavities;
     j["surface_vertices"] = r.surface_vertices;
     j["box_vertices"] = r.box_vertices;
     j["projection_fallbacks"] = r.projection_fallbacks;
@@ -407,11 +399,6 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--min-component", a->min_component,
                   "Drop connected parts with fewer hexes (default 8: a part smaller than a 2x2x2 block of cells is below "
                   "the cell size, mostly a scan's noise, and would float free in a solver; 0 keeps every part)");
-  cmd->add_option("--min-cavity", a->min_cavity,
-                  "Fill enclosed voids of the region with fewer grid points (e.g. 8: voids below a 2x2x2 block of "
-                  "samples, mostly a scan's noise, whose tiny closed surfaces force poorly shaped hexes around them; "
-                  "default 0 keeps every void). Filled before --min-component drops parts")
-      ->check(CLI::Range(Index{0}, std::numeric_limits<Index>::max()));
   cmd->add_option("--refine-boundary", a->refine_tolerance,
                   "Refine (by 3, conforming templates) the hexes under boundary quads that chord the isosurface "
                   "deeper than TOL x cell size, new boundary vertices on the isosurface (e.g. 0.02)")

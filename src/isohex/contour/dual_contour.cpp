@@ -336,20 +336,14 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   rep.repair_rounds = repaired.rounds;
   rep.time_repair = seconds_since(t);
 
-  if (options.min_cavity > 1 || options.min_component > 1) t = stage("components");
-  if (options.min_cavity > 1) {
-    const CavityCounts cv = fill_small_cavities(g, static_cast<std::size_t>(options.min_cavity));
-    rep.filled_cavities = cv.filled;
-    rep.filled_cavity_points = cv.filled_points;
-    rep.kept_cavities = cv.kept;
-  }
   if (options.min_component > 1) {
+    t = stage("components");
     const ComponentCounts cc = remove_small_components(g, static_cast<std::size_t>(options.min_component));
     rep.dropped_components = cc.removed;
     rep.dropped_hexes = cc.removed_points;
     rep.components = cc.kept;
+    rep.time_components = seconds_since(t);
   }
-  if (options.min_cavity > 1 || options.min_component > 1) rep.time_components = seconds_since(t);
 
   t = stage("dual vertices");
   const std::size_t nx = g.num_cells(0), ny = g.num_cells(1), nz = g.num_cells(2);

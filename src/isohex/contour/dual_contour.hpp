@@ -74,9 +74,6 @@ struct ExtractOptions {
   double cell_size = 0;      ///< h in world units; 0 = use `resolution`
   Index resolution = 64;     ///< cells along the domain's longest axis when cell_size is 0
   Index min_component = 0;   ///< drop connected parts with fewer hexes than this
-  /// Fill enclosed voids (cavities of the region) with fewer grid points than this; they are
-  /// filled before small parts are dropped, so a speck inside a filled void joins its host.
-  Index min_cavity = 0;
   /// Called as each stage starts ("sampling", "manifold repair", ...), e.g. for progress.
   std::function<void(std::string_view stage)> on_stage;
 };
@@ -111,9 +108,6 @@ struct ExtractReport {
   std::size_t dropped_components = 0;  ///< parts below min_component
   std::size_t dropped_hexes = 0;
   std::size_t components = 0;          ///< connected parts kept (counted when min_component > 1)
-  std::size_t filled_cavities = 0;     ///< enclosed voids below min_cavity, filled
-  std::size_t filled_cavity_points = 0;  ///< their grid points (made inside)
-  std::size_t kept_cavities = 0;       ///< enclosed voids kept (counted when min_cavity > 1)
   std::size_t split_cells = 0;         ///< cells with more than one dual vertex
   std::size_t surface_vertices = 0;    ///< vertices on a surface of the region
   std::size_t box_vertices = 0;        ///< vertices on the domain box (not checked against a surface)

@@ -1,5 +1,5 @@
 // Edits of the grid by connected parts: the fill of zero-volume cavities (before the manifold
-// repair), and the fill of small cavities and removal of small components (after it).
+// repair) and the removal of small components (after it).
 #include "isohex/contour/repair_internal.hpp"
 #include "isohex/contour/sampled_grid.hpp"
 
@@ -126,58 +126,6 @@ ComponentCounts remove_small_components(SampledGrid& g, std::size_t min_points) 
   if (counts.removed)
     for (std::size_t p = 0; p < g.inside.size(); ++p)
       if (g.inside[p] && sizes[static_cast<std::size_t>(label[p])] < min_points) g.inside[p] = 0;
-  return counts;
-}
-
-CavityCounts fill_small_cavities(SampledGrid& g, std::size_t min_points) {
-  CavityCounts counts;
-  const std::size_t nx = g.padded[0], ny = g.padded[1], nz = g.padded[2], dy = nx, dz = nx * ny;
-  // 26-neighbours: the complement of the 6-connected inside. A void that touches the open
-  // outside only through an edge or a corner is then open, never filled.
-  std::vector<std::ptrdiff_t> nb;
-  for (int z = -1; z <= 1; ++z)
-    for (int y = -1; y <= 1; ++y)
-      for (int x = -1; x <= 1; ++x)
-        if (x || y || z) nb.push_back(x + static_cast<std::ptrdiff_t>(dy) * y + static_cast<std::ptrdiff_t>(dz) * z);
-  auto padding = [&](std::size_t p) {
-    const std::size_t i = p % nx, j = p / nx % ny, k = p / dz;
-    return i == 0 || j == 0 || k == 0 || i + 1 == nx || j + 1 == ny || k + 1 == nz;
-  };
-  // Sequential flood fill in grid order: the result depends only on the grid.
-  std::vector<std::uint8_t> seen(g.inside.size(), 0);
-  std::vector<std::size_t> part, stack;
-  for (std::size_t k = 1; k + 1 < nz; ++k)
-    for (std::size_t j = 1; j + 1 < ny; ++j)
-      for (std::size_t seed = dz * k + dy * j + 1, end = dz * k + dy * j + nx - 1; seed < end; ++seed) {
-        if (g.inside[seed] || seen[seed]) continue;
-        bool open = false;
-        part.assign(1, seed);
-        stack.assign(1, seed);
-        seen[seed] = 1;
-        while (!stack.empty()) {
-          const std::size_t p = stack.back();
-          stack.pop_back();
-          for (std::ptrdiff_t d : nb) {  // p is not padding, so its neighbours are in the array
-            const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) + d);
-            if (g.inside[q] || seen[q]) continue;
-            if (padding(q)) {
-              open = true;  // not walked: the padding is one open outside
-              continue;
-            }
-            seen[q] = 1;
-            part.push_back(q);
-            stack.push_back(q);
-          }
-        }
-        if (open) continue;
-        if (part.size() >= min_points) {
-          ++counts.kept;
-          continue;
-        }
-        for (std::size_t p : part) g.inside[p] = 1;
-        ++counts.filled;
-        counts.filled_points += part.size();
-      }
   return counts;
 }
 

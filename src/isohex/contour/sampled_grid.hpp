@@ -1,8 +1,8 @@
 #pragma once
 /// \file sampled_grid.hpp
 /// \brief The inside/outside classification of the dual-contouring grid, padded with a layer
-/// of outside points, and the edits made to it before meshing: manifold repair, fill of small
-/// cavities and removal of small components.
+/// of outside points, and the edits made to it before meshing: manifold repair and removal
+/// of small components.
 
 #include "isohex/contour/dual_contour.hpp"
 
@@ -140,15 +140,5 @@ struct ComponentCounts {
   std::size_t removed = 0, kept = 0, removed_points = 0;
 };
 ComponentCounts remove_small_components(SampledGrid& g, std::size_t min_points);
-
-/// Fills the cavities (parts of the outside points, 26-connected, that do not reach the
-/// padding: voids enclosed by the region) with fewer than `min_points` points. Every cell that
-/// has a corner in such a cavity has all its outside corners in it, so after the fill those
-/// cells are wholly inside and no other cell changes: the grid stays manifold. Returns the
-/// numbers of cavities filled and kept, and of points filled.
-struct CavityCounts {
-  std::size_t filled = 0, kept = 0, filled_points = 0;
-};
-CavityCounts fill_small_cavities(SampledGrid& g, std::size_t min_points);
 
 }  // namespace isohex::contour
