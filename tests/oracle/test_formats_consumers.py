@@ -33,6 +33,7 @@ import sys
 import numpy as np
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtk_support import read_vtu
 
 FAILURES = []
 
@@ -50,13 +51,6 @@ def run(cmd):
 
 
 # ---- meshes and the VTK reference ----------------------------------------------------------
-
-def read_vtu(path):
-    r = vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(path)
-    r.Update()
-    return r.GetOutput()
-
 
 def write_vtu(grid, path):
     w = vtk.vtkXMLUnstructuredGridWriter()

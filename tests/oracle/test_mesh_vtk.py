@@ -34,6 +34,7 @@ import sys
 import numpy as np
 import vtk
 from vtk.util import numpy_support as ns
+from vtk_support import read_vtu
 
 VOL = "volumes"
 
@@ -214,11 +215,8 @@ def marching_cubes(a, spacing, origin, iso, h, rng, edits=()):
 
 
 def hex_boundary(mesh_file):
-    r = vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(mesh_file)
-    r.Update()
     s = vtk.vtkDataSetSurfaceFilter()
-    s.SetInputConnection(r.GetOutputPort())
+    s.SetInputData(read_vtu(mesh_file))
     s.Update()
     return surface_stats(s.GetOutput())
 

@@ -29,6 +29,7 @@ import sys
 import numpy as np
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray, vtk_to_numpy
+from vtk_support import hex_quality
 
 DBL_MIN_NEW = 2.2204460492503131e-15  # Verdict >= 1.4.4, on normalised coordinates
 DBL_MIN_OLD = 1e-30                   # VTK 9.1's Verdict, on raw coordinates
@@ -181,11 +182,7 @@ def vtk_grid(points, hexes):
 
 
 def vtk_quality(grid, metric):
-    q = vtk.vtkMeshQuality()
-    q.SetInputData(grid)
-    getattr(q, "SetHexQualityMeasureTo" + VTK_MEASURE[metric])()
-    q.Update()
-    return vtk_to_numpy(q.GetOutput().GetCellData().GetArray("Quality")).astype(np.float64)
+    return hex_quality(grid, VTK_MEASURE[metric])
 
 
 def cli_values(cli, mesh, metric, out_csv, n, extra=()):

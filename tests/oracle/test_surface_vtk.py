@@ -21,6 +21,7 @@ import sys
 import numpy as np
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
+from vtk_support import read_vtu
 
 FAILURES = []
 
@@ -33,11 +34,8 @@ def check(ok, what):
 
 def boundary(path):
     """The boundary quads' scaled Jacobians (VTK) and fan margins (numpy) of a mesh file."""
-    r = vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(path)
-    r.Update()
     s = vtk.vtkDataSetSurfaceFilter()
-    s.SetInputData(r.GetOutput())
+    s.SetInputData(read_vtu(path))
     s.Update()
     q = vtk.vtkMeshQuality()
     q.SetInputData(s.GetOutput())
