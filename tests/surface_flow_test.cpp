@@ -88,6 +88,35 @@ TEST(SurfaceGraph, ColourClassesShareNoHex) {
   EXPECT_EQ(total, all.size());
 }
 
+// The max–min pass moves the members of a class in parallel. With the hex guard on (no pillow
+// follows), a move reads every corner of the vertex's hexes, so no two members may share a hex.
+// A slab one cell thick has hexes whose top and bottom vertices are both on the boundary but
+// not near each other through the quads: the quad reads alone put such pairs in one class.
+TEST(SurfaceGraph, ReadDisjointClassesHonourTheHexGuard) {
+  const HexMesh m = box_mesh(4, 4, 1);
+  const SurfaceGraph g = build_surface_graph(m, kCos60);
+  std::vector<Index> all(m.points.size());
+  for (Index v = 0; v < m.num_vertices(); ++v) all[v] = v;  // every vertex of a slab is on the boundary
+  const auto shared_hexes = [&](const std::vector<std::vector<Index>>& classes) {
+    std::size_t shared = 0;
+    for (const auto& cls : classes) {
+      const std::set<Index> members(cls.begin(), cls.end());
+      for (const Hex& h : m.hexes) {
+        int in = 0;
+        for (Index v : h) in += members.count(v) > 0;
+        shared += in > 1;
+      }
+    }
+    return shared;
+  };
+  EXPECT_GT(shared_hexes(read_disjoint_classes(all, g)), 0u);  // quads only: the race that was
+  const auto guarded = read_disjoint_classes(all, g, &m);
+  EXPECT_EQ(shared_hexes(guarded), 0u);
+  std::size_t total = 0;
+  for (const auto& cls : guarded) total += cls.size();
+  EXPECT_EQ(total, all.size());
+}
+
 TEST(SurfaceFlow, DiffusionFlattensABumpAndKeepsVolume) {
   // The top face z = 0 of an 8 x 8 x 2 block, its centre vertex raised: surface diffusion
   // must push the bump down and its ring up, with normal moves summing to zero (volume kept).

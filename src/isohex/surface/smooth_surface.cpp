@@ -161,7 +161,7 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
     if (work.empty()) break;
     report.worst_passes = pass + 1;
     std::size_t moved = 0;
-    for (const auto& cls : surface_detail::read_disjoint_classes(work, ctx.graph)) {
+    for (const auto& cls : surface_detail::read_disjoint_classes(work, ctx.graph, ctx.guard_hexes ? &mesh : nullptr)) {
       tbb::parallel_for(std::size_t{0}, cls.size(), [&](std::size_t i) {
         outcome[cls[i]] =
             surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius, options.worst_levels, turned,

@@ -130,13 +130,19 @@ std::vector<std::vector<Index>> colour_classes(const std::vector<Index>& vertice
   return classes;
 }
 
-std::vector<std::vector<Index>> read_disjoint_classes(const std::vector<Index>& vertices, const SurfaceGraph& graph) {
+std::vector<std::vector<Index>> read_disjoint_classes(const std::vector<Index>& vertices, const SurfaceGraph& graph,
+                                                      const HexMesh* guarded) {
   const auto reads = [&](Index v, auto&& f) {
     const auto each_quad_vertex = [&](Index w) {
       for (Index k = graph.vertex_quads.offsets[w]; k < graph.vertex_quads.offsets[w + 1]; ++k)
         for (Index x : graph.quads[graph.vertex_quads.ids[k]]) f(x);
     };
     each_quad_vertex(v);
+    // The hex guard reads every corner of v's hexes, which reach boundary vertices beyond the
+    // quads (a hex with two boundary faces: a slab one cell thick).
+    if (guarded)
+      for (Index k = graph.vertex_hexes.offsets[v]; k < graph.vertex_hexes.offsets[v + 1]; ++k)
+        for (Index x : guarded->hexes[graph.vertex_hexes.ids[k]]) f(x);
     for (Index k = graph.boundary_neighbours.offsets[v]; k < graph.boundary_neighbours.offsets[v + 1]; ++k)
       each_quad_vertex(graph.boundary_neighbours.ids[k]);
   };

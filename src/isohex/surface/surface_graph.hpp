@@ -46,7 +46,9 @@ std::vector<std::vector<Index>> colour_classes(const std::vector<Index>& vertice
 
 /// Splits boundary vertices `vertices` into classes such that no member of a class reads
 /// another: v reads the vertices of the boundary quads around v and around its boundary
-/// neighbours (what the max–min pass's score of v looks at). Greedy, in the given order.
-std::vector<std::vector<Index>> read_disjoint_classes(const std::vector<Index>& vertices, const SurfaceGraph& graph);
+/// neighbours (what the max–min pass's score of v looks at) and, when `guarded` is given, the
+/// vertices of the hexes around v (the hex guard of the move). Greedy, in the given order.
+std::vector<std::vector<Index>> read_disjoint_classes(const std::vector<Index>& vertices, const SurfaceGraph& graph,
+                                                      const HexMesh* guarded = nullptr);
 
 }  // namespace isohex::surface_detail
