@@ -1,8 +1,12 @@
 // Abaqus .inp reader and writer: automesh's files, exact round trips, arbitrary ids,
 // continuation lines, element sets as blocks, the FIXED node set, malformed input and
-// truncation.
+// truncation; numbers in the 20 characters CalculiX reads.
 
 #include "io_legacy_support.hpp"
+#include "isohex/io/abaqus.hpp"
+
+#include <cstdlib>
+#include <random>
 
 namespace isohex::test {
 namespace {
@@ -45,6 +49,82 @@ HexMesh two_hexes(std::vector<Index> blocks = {5, 2}) {
   HexMesh m = grid_mesh(2, 1, 1);
   m.blocks = std::move(blocks);
   return m;
+}
+
+/// awkward_mesh with -DBL_MAX, which no 20-character field holds exactly, as -1e308.
+HexMesh awkward_mesh_in_20_characters(bool with_blocks, bool with_fixed) {
+  HexMesh m = awkward_mesh(with_blocks, with_fixed);
+  for (Vec3& p : m.points)
+    for (int c = 0; c < 3; ++c)
+      if (p[c] == -std::numeric_limits<double>::max()) p[c] = -1e308;
+  return m;
+}
+
+/// Reals that are hard to spell in 20 characters: negative, tiny, huge, subnormal, beside
+/// the largest double, at the ends of %g's fixed range; random bit patterns (every sign and
+/// exponent); random coordinates of an ordinary mesh (1e-4 to 10 in size).
+std::vector<double> hard_reals() {
+  const double big = std::numeric_limits<double>::max(), tiny = std::numeric_limits<double>::denorm_min();
+  std::vector<double> v = {-0.018695458531368891, -1.2345678901234567e-300, 1.2345678901234567e-300, -big, big,
+                           std::nextafter(big, 0.0), -std::nextafter(big, 0.0), -std::numeric_limits<double>::min(),
+                           tiny, -3 * tiny, -1.2345678901234567e-310, -1.2345678901234567e17, 1.2345678901234567e17,
+                           -1.2345678901234567e16, 1.2345678901234567e19, -1.2345678901234567e20,
+                           -9.8765432109876543e99, -9.8765432109876543e100,
+                           -0.0012345678901234567, -0.00012345678901234567, -1.2345678901234567e-5,
+                           -9.9999999999999995e-5, -0.099999999999999992, -1.0 / 3.0, -2.0 / 3.0 * 1e-3, -0.0, 0.0,
+                           0.1, -M_PI * 1e-7};
+  std::mt19937_64 rng(15);
+  while (v.size() < 20000) {
+    const double x = std::bit_cast<double>(rng());
+    if (std::isfinite(x)) v.push_back(x);
+  }
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> decade(-4, 1);
+  for (int i = 0; i < 20000; ++i) v.push_back(unit(rng) * std::pow(10.0, decade(rng)));
+  return v;
+}
+
+/// The decimal exponent of x's 17-digit rounding (log10 can be one off next to a power of 10).
+int decimal_exponent(double x) {
+  const std::string s = fmt::format("{:.16e}", x);
+  return std::stoi(s.substr(s.find('e') + 1));
+}
+
+/// The significant digits a field of 20 characters holds for x, worked out from the lengths
+/// of its spellings: fixed without the 0 before the point (".0012..."), or with an exponent
+/// as short as it goes ("1.2e-5", "1.2e17"); at most 17.
+int digits_that_fit(double x) {
+  if (x == 0) return 17;
+  const int sign = std::signbit(x) ? 1 : 0, e = decimal_exponent(x);
+  const int e_digits = static_cast<int>(std::to_string(std::abs(e)).size()) + (e < 0 ? 1 : 0);
+  for (int p = 17;; --p) {
+    const int exponent_form = sign + p + (p > 1 ? 1 : 0) + 1 + e_digits;
+    const int fixed_form = e < 0 ? sign + 1 + (-e - 1) + p : e < p ? sign + p + 1 : 1000;
+    if (std::min(exponent_form, fixed_form) <= static_cast<int>(io::kAbaqusFieldWidth)) return p;
+  }
+}
+
+/// What a field written for x must read back as: x itself when its %.17g, its shortest exact
+/// spelling or its integer digits fit 20 characters; otherwise x to within half a unit in the
+/// digits_that_fit-th digit (and the error of reading that decimal into a double), never
+/// infinite.
+void expect_field_holds(double x, double back, std::string_view field) {
+  SCOPED_TRACE(fmt::format("{:.17g} written as '{}'", x, field));
+  const std::size_t width = io::kAbaqusFieldWidth;
+  EXPECT_LE(field.size(), width);
+  EXPECT_TRUE(std::isfinite(back));
+  if (fmt::format("{:.17g}", x).size() <= width || fmt::format("{}", x).size() <= width ||
+      (std::abs(x) >= 1e16 && fmt::format("{:.0f}", x).size() <= width)) {
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(back), std::bit_cast<std::uint64_t>(x));
+    return;
+  }
+  int p = digits_that_fit(x);
+  EXPECT_GE(p, 13);
+  if (std::abs(x) > 1.797693134862315e308) --p;  // its rounding would pass the largest double
+  // long double: half a unit in the 13th digit of a subnormal is below the smallest double.
+  const long double bound = 0.5L * std::pow(10.0L, decimal_exponent(x) - p + 1) * (1 + 1e-12L) +
+                            std::abs(x) * 0x1p-52L + std::numeric_limits<double>::denorm_min();
+  EXPECT_LE(static_cast<long double>(std::abs(back - x)), bound);
 }
 
 TEST(Abaqus, AutomeshFilesLoad) {
@@ -106,7 +186,7 @@ TEST(Abaqus, RoundTripsAwkwardCoordinatesExactly) {
   for (const bool blocks : {false, true})
     for (const bool fixed : {false, true}) {
       SCOPED_TRACE(fmt::format("blocks {} fixed {}", blocks, fixed));
-      const HexMesh m = awkward_mesh(blocks, fixed);
+      const HexMesh m = awkward_mesh_in_20_characters(blocks, fixed);
       io::write_mesh(dir / "m.inp", m);
       expect_same_mesh(m, io::read_mesh(dir / "m.inp"));
     }
@@ -133,6 +213,86 @@ TEST(Abaqus, RoundTripsAwkwardCoordinatesExactly) {
   }
   EXPECT_EQ(elements, 3u);
   EXPECT_EQ(set_lines, (big.points.size() + 15) / 16);
+}
+
+TEST(Abaqus, RealsFitTwentyCharactersWithTheMostDigits) {
+  for (const double x : hard_reals()) {
+    const std::string field = io::abaqus_real(x);
+    expect_field_holds(x, std::strtod(field.c_str(), nullptr), field);
+    if (::testing::Test::HasFailure()) return;
+  }
+  // The most digits that fit, worked out by hand: 17 without the 0 before the point, fewer
+  // with a short exponent; the largest double's 15 digits would round past it.
+  const std::pair<double, const char*> spelled[] = {
+      {-0.018695458531368891, "-.018695458531368891"},  // CalculiX truncated %.17g's 21 characters
+      {0.33333333333333331, "0.33333333333333331"},     // %.17g where it fits
+      {-0.0012345678901234567, "-.001234567890123457"},
+      {-1.2345678901234567e-5, "-1.23456789012346e-5"},
+      {-1.2345678901234567e-300, "-1.234567890123e-300"},
+      {1.2345678901234567e-300, "1.2345678901235e-300"},
+      {-1.2345678901234567e17, "-123456789012345664"},  // the double's exact integer digits
+      {-1.2345678901234567e20, "-1.23456789012346e20"},
+      {1.2345678901234567e20, "1.234567890123457e20"},
+      {std::numeric_limits<double>::max(), "1.7976931348623e+308"},
+      {-std::numeric_limits<double>::max(), "-1.7976931348623e308"},
+      {1e-300, "1e-300"},
+      {-0.0, "-0"}};
+  for (const auto& [x, text] : spelled) EXPECT_EQ(io::abaqus_real(x), text) << fmt::format("{:.17g}", x);
+}
+
+TEST(Abaqus, EveryFieldOfAWrittenFileFitsCalculiX) {
+  const fs::path dir = scratch_dir();
+  const std::vector<double> reals = hard_reals();
+  HexMesh m = grid_mesh(6, 5, 4);
+  m.blocks.assign(m.hexes.size(), -2147483647);  // the longest ELSET name
+  m.fixed.assign(m.points.size(), 1);
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    for (int c = 0; c < 3; ++c) m.points[v][c] = reals[(3 * v + static_cast<std::size_t>(c)) * 97 % reals.size()];
+  for (std::size_t k = 0; k < 27; ++k) m.points[k / 3][static_cast<int>(k % 3)] = reals[k];  // the chosen ones
+  io::write_mesh(dir / "m.inp", m);
+  const std::string text = io::read_file(dir / "m.inp");
+  std::size_t node_lines = 0;
+  bool in_nodes = false;
+  for (std::size_t at = 0, end; at < text.size(); at = end + 1) {
+    end = text.find('\n', at);
+    const std::string line = text.substr(at, end - at);
+    EXPECT_LE(line.size(), 256u) << line;  // Abaqus' longest line
+    if (line.starts_with("*")) {
+      in_nodes = line.starts_with("*NODE");
+      continue;
+    }
+    std::vector<std::string_view> fields;
+    for (std::string_view rest = line;;) {
+      const auto comma = rest.find(',');
+      std::string_view f = rest.substr(0, comma);
+      while (f.starts_with(' ')) f.remove_prefix(1);
+      fields.push_back(f);
+      if (comma == std::string_view::npos) break;
+      rest.remove_prefix(comma + 1);
+    }
+    EXPECT_LE(fields.size(), 16u) << line;  // CalculiX splits a line into 16 fields at most
+    for (const std::string_view f : fields) EXPECT_LE(f.size(), io::kAbaqusFieldWidth) << line;
+    if (!in_nodes) continue;
+    ASSERT_EQ(fields.size(), 4u) << line;
+    const std::size_t v = node_lines++;
+    EXPECT_EQ(fields[0], std::to_string(v + 1));
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::string field(fields[c + 1]);
+      expect_field_holds(m.points[v][static_cast<int>(c)], std::strtod(field.c_str(), nullptr), field);
+    }
+  }
+  EXPECT_EQ(node_lines, m.points.size());
+  // isohex reads back what the fields say.
+  const HexMesh back = io::read_mesh(dir / "m.inp");
+  ASSERT_EQ(back.points.size(), m.points.size());
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      const std::string field = io::abaqus_real(m.points[v][c]);
+      EXPECT_EQ(back.points[v][c], std::strtod(field.c_str(), nullptr)) << field;
+    }
+  HexMesh same = back;
+  same.points = m.points;
+  expect_same_mesh(m, same);
 }
 
 TEST(Abaqus, RoundTripsSharedFiles) {

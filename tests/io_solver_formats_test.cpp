@@ -146,7 +146,10 @@ TEST(SolverFormats, AbaqusWritesSetsAndSurfaceAndStillReadsBack) {
   EXPECT_EQ(text.find("1, S4\n", surface), std::string::npos);  // the shared +x face is inside
   EXPECT_EQ(std::count(text.begin() + static_cast<std::ptrdiff_t>(surface), text.end(), 'S'), 1 + 10);
   expect_same_mesh(m, io::read_mesh(dir / "m.inp"));
-  const HexMesh f = awkward_mesh(true, true);
+  HexMesh f = awkward_mesh(true, true);
+  for (Vec3& p : f.points)  // no 20-character field, the most CalculiX reads, holds -DBL_MAX exactly
+    for (int c = 0; c < 3; ++c)
+      if (p[c] == -std::numeric_limits<double>::max()) p[c] = -1e308;
   expect_same_mesh(f, read_back(dir / "f.inp", f));
 }
 

@@ -11,7 +11,11 @@
 //
 // The writer adds what a solver deck needs to refer to: *ELSET ALLHEXES, *NSET BOUNDARY
 // (the boundary nodes) and *SURFACE BOUNDARY, the boundary quads as element faces S1..S6
-// in Abaqus' C3D8 face numbering (solver_sets.hpp).
+// in Abaqus' C3D8 face numbering (solver_sets.hpp). Every field of its data lines fits in
+// the 20 characters CalculiX reads a number from (abaqus.hpp), every line in the 256
+// characters Abaqus allows.
+
+#include "isohex/io/abaqus.hpp"
 
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
@@ -23,9 +27,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -405,6 +412,74 @@ class AbaqusReader {
   std::size_t skipped_ = 0;
 };
 
+// ---- numbers that fit a field ----------------------------------------------------------
+
+/// A number as the writer spells it, at most kAbaqusFieldWidth characters.
+class Field {
+ public:
+  [[nodiscard]] std::string_view view() const { return {text_.data(), size_}; }
+  template <class... Args>
+  void set(fmt::format_string<Args...> format, Args&&... args) {
+    const auto r = fmt::format_to_n(text_.data(), text_.size(), format, std::forward<Args>(args)...);
+    size_ = std::min(r.size, text_.size());  // a double's %.17g has at most 24 characters
+  }
+  /// The same value in fewer characters: "0.x" -> ".x", "e-07" -> "e-7", "e+17" -> "e17",
+  /// and no trailing zeros in an exponent form's digits.
+  void shorten() {
+    std::string s(view());
+    const auto e = s.find('e');
+    if (e == std::string::npos) {
+      const std::size_t at = s.front() == '-' ? 1 : 0;
+      if (s.compare(at, 2, "0.") == 0) s.erase(at, 1);
+    } else {
+      std::size_t end = e;
+      while (s[end - 1] == '0') --end;
+      if (s[end - 1] == '.') --end;
+      s.erase(end, e - end);
+      std::size_t digit = s.find('e') + 1;
+      if (s[digit] == '+')
+        s.erase(digit, 1);
+      else if (s[digit] == '-')
+        ++digit;
+      while (digit + 1 < s.size() && s[digit] == '0') s.erase(digit, 1);
+    }
+    size_ = std::min(s.size(), text_.size());
+    std::copy_n(s.begin(), size_, text_.begin());
+  }
+  /// True if the text fits a field and reads back finite.
+  [[nodiscard]] bool fits_finite() const {
+    double back = 0;
+    return size_ <= kAbaqusFieldWidth && parse_double(view(), back);  // parse_double refuses an overflow
+  }
+
+ private:
+  std::array<char, 40> text_{};
+  std::size_t size_ = 0;
+};
+
+/// abaqus_real's spelling of x: for p = 17, 16, ... the p-digit rounding as %.{p}g, the same
+/// shortened, then in exponent form shortened; the first that fits. Beyond %.17g's fixed
+/// range (|x| >= 1e17) the exact integer digits come first, which fit up to 1e19 or 1e20.
+Field real_field(double x) {
+  Field f;
+  f.set("{:.17g}", x);
+  if (f.fits_finite()) return f;
+  if (std::abs(x) >= 1e16) {  // above 2^53 every double is an integer
+    f.set("{:.0f}", x);
+    if (f.fits_finite()) return f;
+  }
+  for (int p = 17; p >= 1; --p) {
+    f.set("{:.{}g}", x, p);
+    if (f.fits_finite()) return f;
+    f.shorten();
+    if (f.fits_finite()) return f;
+    f.set("{:.{}e}", x, p - 1);
+    f.shorten();
+    if (f.fits_finite()) return f;
+  }
+  throw std::logic_error(fmt::format("no {}-character spelling of {}", kAbaqusFieldWidth, x));  // p = 13 always fits
+}
+
 /// 1-based ids of `vertices`, 16 to a line: the most Abaqus allows on a set data line.
 void write_id_lines(TextOut& text, const std::vector<Index>& vertices) {
   for (std::size_t i = 0; i < vertices.size(); ++i)
@@ -412,12 +487,17 @@ void write_id_lines(TextOut& text, const std::vector<Index>& vertices) {
                i % 16 == 15 || i + 1 == vertices.size() ? "\n" : "");
 }
 
+// CalculiX reads ids with the format i10: 1-based 32-bit indices have at most 10 digits.
+static_assert(sizeof(Index) <= 4);
+
 void write_inp(std::ostream& out, const HexMesh& mesh) {
   TextOut text(out);
-  text.print("*HEADING\nisohex hex mesh\n*NODE, NSET=ALLNODES\n");
+  // A comment, not *HEADING: CalculiX refuses a second *HEADING, so a file with one could
+  // not be included in a deck that has its own.
+  text.print("** isohex hex mesh\n*NODE, NSET=ALLNODES\n");
   for (std::size_t v = 0; v < mesh.points.size(); ++v) {
     const Vec3& p = mesh.points[v];
-    text.print("{}, {:.17g}, {:.17g}, {:.17g}\n", v + 1, p.x(), p.y(), p.z());
+    text.print("{}, {}, {}, {}\n", v + 1, real_field(p.x()).view(), real_field(p.y()).view(), real_field(p.z()).view());
   }
   // One *ELEMENT per block; element ids keep the hex order, which the reader restores.
   std::vector<std::size_t> order(mesh.hexes.size());
@@ -456,6 +536,8 @@ void write_inp(std::ostream& out, const HexMesh& mesh) {
 }
 
 }  // namespace
+
+std::string abaqus_real(double x) { return std::string(real_field(x).view()); }
 
 HexMesh read_abaqus(const fs::path& file, const ReadOptions& options, ReadReport* report) {
   const std::string text = read_file(file);
