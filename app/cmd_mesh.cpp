@@ -235,6 +235,14 @@ void run(const Args& a) {
   const contour::SurfaceDistance dist = contour::surface_distance(region, out.mesh, out.vertex_place, &released);
   const std::vector<double> sj = scaled_jacobians(out.mesh);
   const MetricSummary summary = summarize(HexMetric::scaled_jacobian, sj);
+  const ValiditySummary validity = summarize_validity(out.mesh);
+  // Vertices outside the sampled domain (a placement across it; 1e-9 of its diagonal spare).
+  std::size_t outside_domain = 0;
+  {
+    const double slack = 1e-9 * (region.domain.hi - region.domain.lo).norm();
+    for (const Vec3& x : out.mesh.points)
+      outside_domain += ((x.array() < region.domain.lo.array() - slack) || (x.array() > region.domain.hi.array() + slack)).any();
+  }
   const double check_time = seconds_since(t);
   t = Clock::now();
   io::write_mesh(a.output, out.mesh);
@@ -279,6 +287,7 @@ void run(const Args& a) {
     fmt::print("  distance to each surface (max |L| / scale): {}\n", each);
   }
   print_summary(summary);
+  fmt::print("  {}; {} vertices outside the domain\n", describe(validity), outside_domain);
   fmt::print("times: read {:.3f} s, sample {:.3f} s, repair {:.3f} s, components {:.3f} s, vertices {:.3f} s, hexes "
              "{:.3f} s, surface smoothing {:.3f} s, check {:.3f} s, write {:.3f} s\n",
              read_time, r.time_sample, r.time_repair, r.time_components, r.time_vertices, r.time_hexes, smooth_time,
@@ -347,6 +356,8 @@ void run(const Args& a) {
     j["surface_distances"] = per;
     j["box_max_relative_distance"] = dist.box_max_relative;
     j["scaled_jacobian"] = to_json(summary);
+    j["validity"] = to_json(validity);
+    j["outside_domain_vertices"] = outside_domain;
     j["times"] = {{"read", read_time},          {"sample", r.time_sample}, {"repair", r.time_repair},
                   {"components", r.time_components}, {"vertices", r.time_vertices}, {"hexes", r.time_hexes},
                   {"surface_smoothing", smooth_time}, {"check", check_time}, {"write", write_time}};

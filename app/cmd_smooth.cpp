@@ -145,9 +145,12 @@ void run(const Args& a) {
 
   const MetricSummary after = sj_summary(mesh);
   print_quality("after", after);
+  const ValiditySummary validity = summarize_validity(mesh);
+  fmt::print("        {}\n", describe(validity));
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   fmt::print("time: {:.2f} s\n", seconds);
   report["after"] = quality_json(after);
+  report["validity"] = to_json(validity);
   if (surface) {
     // A self-check in the report: how far the sliding vertices are from the target surface
     // (a distance for the input's boundary, |f - iso| / range for an isosurface).

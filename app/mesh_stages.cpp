@@ -6,6 +6,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 #include "isohex/quality/report.hpp"
 #include "isohex/sheets/pillow.hpp"
 
@@ -136,12 +137,18 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
   // one voxel thick), its vertices of those hexes are released into the band and the whole
   // sequence runs again around them: on the hexes within kRings hex rings of those below
   // 0.2, the rest held (the rest has converged already; re-running all of it doubled the
-  // stage's time). Two more rounds catch what is still below 0.2, reaching one ring of hexes
-  // further for the release (an inner hex squeezed between sheets has no boundary vertex).
+  // stage's time). Up to four more rounds catch what is still below 0.2, reaching one ring of
+  // hexes further for the release (an inner hex squeezed between sheets has no boundary
+  // vertex); they stop as soon as a round releases nothing (cthead h 4 needed 5).
   constexpr int kRings = 3;
   const Incidence inc = vertex_hexes(mesh);
-  for (int round = 1; round <= 3; ++round) {
-    const std::vector<double> sj = scaled_jacobians(mesh);
+  for (int round = 1; round <= 5; ++round) {
+    // Hexes that need the release: below 0.2 by the certified scaled Jacobian, or valid inside
+    // with a jacobian ratio below 0.1 (a fold about to open: the worst pass ranks them alike).
+    std::vector<double> sj = certified_scaled_jacobians(mesh);
+    const std::vector<double> ratio = jacobian_ratios(mesh);
+    for (std::size_t h = 0; h < sj.size(); ++h)
+      if (!is_degenerate(sj[h])) sj[h] = std::min(sj[h], 2 * ratio[h]);
     std::vector<Index> candidates;
     const auto add = [&](Index h) {
       for (Index v : mesh.hexes[h])

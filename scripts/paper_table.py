@@ -5,7 +5,12 @@ before/after pillowing, the elements below 0.2 before (after surface smoothing, 
 "original mesh") and after (pillowing + optimisation), inverted, min scaled Jacobian and time,
 beside the paper's figures. Writes the Markdown table to --out (default docs/paper-table.md).
 
-    /usr/bin/python3 scripts/paper_table.py --cli build/bin/isohex --data ../shared/data
+    /usr/bin/python3 scripts/paper_table.py --cli build/bin/isohex --data ../shared/data [--other-sizes]
+
+Each row also has what a solver sees: hexes not certified valid inside and with det J <= 0 at
+a Gauss point, the smallest jacobian ratio (min/max det J) with the count below 0.1, the largest
+edge ratio, the volume excess of the hexes' |det J| over the enclosed volume (overlap) and the
+vertices outside the sampled domain.
 """
 import argparse
 import datetime
@@ -65,6 +70,32 @@ def cases(data, tmp):
     ]
 
 
+def other_sizes(data):
+    """Other cell sizes of the same scans (issue 15: a default that holds off the table's rows)."""
+    v = lambda f: os.path.join(data, "volumes", f)
+    return [
+        ("cthead (skin, h 3)", None, [v("cthead_256x256x113_int16be.raw"), "--iso", "600", "--cell-size", "3"] + CTHEAD, None),
+        ("cthead (skin, h 2)", None, [v("cthead_256x256x113_int16be.raw"), "--iso", "600", "--cell-size", "2"] + CTHEAD, None),
+        ("headsq (bone, h 2)", None, [v("headsq_64x64x93_int16le.raw"), "--iso", "1150", "--cell-size", "2"] + HEADSQ, None),
+        ("headsq (bone, h 4)", None, [v("headsq_64x64x93_int16le.raw"), "--iso", "1150", "--cell-size", "4"] + HEADSQ, None),
+        ("MR head (iso 40, h 3)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "3"], None),
+    ]
+
+
+def inside_measures(cli, mesh, tmp):
+    """What a solver sees (issue 15): hexes not valid inside, det J <= 0 at a Gauss point, the
+    smallest jacobian ratio and how many are below 0.1, the largest edge ratio, the volume
+    excess of |det J| over the enclosed volume: from `isohex check` and `isohex quality`."""
+    chk, qj = os.path.join(tmp, "check.json"), os.path.join(tmp, "quality.json")
+    subprocess.run([cli, "check", mesh, "--json", chk], capture_output=True)
+    subprocess.run([cli, "quality", mesh, "--metric", "edge_ratio", "--json", qj], capture_output=True)
+    c, q = json.load(open(chk)), json.load(open(qj))
+    v = q["validity"]
+    return {"invalid": v["not_valid_inside"], "gauss": v["gauss_nonpositive"], "ratio": v["jacobian_ratio_min"],
+            "poor": v["jacobian_ratio_poor"] + v["not_valid_inside"], "edge_ratio": q["metrics"]["edge_ratio"]["max"],
+            "excess": c["volume"]["excess"]}
+
+
 def row_of(stages, name):
     for s in stages:
         if s["stage"] == name:
@@ -78,14 +109,16 @@ def main():
     ap.add_argument("--data", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data"))
     ap.add_argument("--out", default=os.path.join(os.path.dirname(__file__), "..", "docs", "paper-table.md"))
     ap.add_argument("--only", default="", help="comma-separated case names (prefixes)")
+    ap.add_argument("--other-sizes", action="store_true", help="also other cell sizes of the same scans")
     args = ap.parse_args()
     if not os.path.isdir(os.path.join(args.data, "volumes")):
         sys.exit(f"{args.data}: no volumes/ folder (the shared data)")
     tmp = tempfile.mkdtemp(prefix="isohex-paper-")
     lines = ["| case | hexes before → after pillowing | < 0.2 before → after | inverted after | min SJ after | "
-             "mean SJ after | time (s) | paper: hexes | paper: < 0.2 |",
-             "|---|---|---|---|---|---|---|---|---|"]
-    for name, paper, mesh_args, prep in cases(args.data, tmp):
+             "mean SJ after | not valid inside / det J ≤ 0 at a Gauss point | min jacobian ratio (< 0.1) | "
+             "max edge ratio | volume excess | outside the domain | time (s) | paper: hexes | paper: < 0.2 |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, paper, mesh_args, prep in cases(args.data, tmp) + (other_sizes(args.data) if args.other_sizes else []):
         if args.only and not any(name.startswith(o) for o in args.only.split(",")):
             continue
         if prep:
@@ -98,6 +131,7 @@ def main():
             continue
         j = json.load(open(rep))
         os.remove(rep)
+        m = inside_measures(args.cli, os.path.join(tmp, "mesh.vtu"), tmp)
         st = j["stages"]
         before = row_of(st, "surface smoothing") or row_of(st, "extraction")
         pil, final = row_of(st, "pillowing"), st[-1]
@@ -105,7 +139,8 @@ def main():
         p = PAPER.get(paper) if paper else None
         line = (f"| {name} | {before['hexes']:,} → {pil['hexes'] if pil else final['hexes']:,} | "
                 f"{before['below_0.2']:,} → {final['below_0.2']:,} | {sj['inverted'] + sj['degenerate']:,} | "
-                f"{sj['min']:.3f} | {sj['mean']:.3f} | {j['seconds']:.1f} | "
+                f"{sj['min']:.3f} | {sj['mean']:.3f} | {m['invalid']:,} / {m['gauss']:,} | {m['ratio']:.3f} ({m['poor']:,}) | "
+                f"{m['edge_ratio']:.1f} | {m['excess']:.1e} | {j['outside_domain_vertices']:,} | {j['seconds']:.1f} | "
                 + (f"{p[0]:,} → {p[1]:,} ({paper}) | {p[2]:,} → {p[3]:,} |" if p else "– | – |"))
         print(line, flush=True)
         lines.append(line)

@@ -215,11 +215,29 @@ TEST(MeshCli, SurfaceBandReleasesKnifeEdgesWithinTheBand) {
     // other side. (Within the band of the box a released vertex may be one of a box face's.)
     if (to_box <= 0.97) continue;
     bool crossed = false;
-    const double r = 0.96 * 1.05, step = 0.96 / 24;
+    const double r = 0.96 * 1.05, step = 0.96 / 24, side = l > 0 ? 1.0 : -1.0;
+    Vec3 lowest = Vec3::Zero();  // the lattice point nearest the other side
+    double low = side * l;
     for (double z = -r; z <= r && !crossed; z += step)
       for (double y = -r; y <= r && !crossed; y += step)
-        for (double x = -r; x <= r && !crossed; x += step)
-          if (x * x + y * y + z * z <= r * r) crossed = (f.level(p + Vec3(x, y, z)) > 0) != (l > 0);
+        for (double x = -r; x <= r && !crossed; x += step) {
+          if (x * x + y * y + z * z > r * r) continue;
+          const double s = side * f.level(p + Vec3(x, y, z));
+          crossed = s <= 0;
+          if (s < low) low = s, lowest = Vec3(x, y, z);
+        }
+    // A knife edge can touch the ball in a cap thinner than the lattice: descend from the
+    // lowest lattice point (projected gradient steps within the ball, central differences).
+    for (int it = 0; it < 400 && !crossed; ++it) {
+      const double e = 1e-4;
+      Vec3 g;
+      for (int a = 0; a < 3; ++a)
+        g[a] = side * (f.level(p + lowest + e * Vec3::Unit(a)) - f.level(p + lowest - e * Vec3::Unit(a))) / (2 * e);
+      if (!(g.norm() > 0)) break;
+      lowest -= (step / 4) * g.normalized();
+      if (lowest.norm() > r) lowest *= r / lowest.norm();
+      crossed = side * f.level(p + lowest) <= 0;
+    }
     EXPECT_TRUE(crossed) << i << " at " << p.transpose();
   }
   EXPECT_LE(off, static_cast<std::size_t>(loose));

@@ -7,6 +7,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 #include "isohex/sheets/pillow.hpp"
 #include "isohex/volume/volume_io.hpp"
 #include "test_support.hpp"
@@ -41,7 +42,8 @@ HexMesh slid_box(int n, double amplitude, unsigned seed) {
 struct Outcome {
   HexMesh mesh;
   double objective = 0, min_sj = 0;
-  std::size_t inverted = 0;
+  double min_ratio = 0;  ///< the smallest jacobian ratio (whole element)
+  std::size_t inverted = 0;  ///< inverted at Verdict's samples or not valid inside
 };
 
 // Shape stage then the worst pass, with the boundary fixed or sliding.
@@ -59,9 +61,13 @@ Outcome optimise(const HexMesh& in, bool slide, int threads = 2) {
   wo.surface = so.surface;
   improve_worst(r.mesh, fixed, wo);
   r.min_sj = 1;
-  for (double q : scaled_jacobians(r.mesh)) {
+  const std::vector<double> sj = scaled_jacobians(r.mesh);
+  const MeshJacobians inside = mesh_jacobians(r.mesh);
+  r.min_ratio = *std::min_element(inside.ratio.begin(), inside.ratio.end());
+  for (std::size_t h = 0; h < sj.size(); ++h) {
+    const double q = sj[h];
     r.min_sj = std::min(r.min_sj, is_degenerate(q) ? -1.0 : q);
-    r.inverted += q <= 0 || is_degenerate(q);
+    r.inverted += q <= 0 || is_degenerate(q) || !inside.valid[h];
   }
   return r;
 }
@@ -123,8 +129,13 @@ TEST(OptimizeSlide, BallVerticesStayOnTheOriginalSurface) {
     ASSERT_LE(d, 1e-12) << v;
   }
   EXPECT_GT(moved, 50u);
-  EXPECT_GT(slide.min_sj, fixed.min_sj);
+  // Sliding wins on the shape objective. The minima are held by the flattened hexes along the
+  // cube's diagonals, whose interior (jacobian ratio) the worst pass may not lower to raise
+  // Verdict's samples: there sliding matches the fixed boundary (measured: SJ 0.106 vs 0.108,
+  // ratio 0.0426 vs 0.0428), it does not beat it.
   EXPECT_LT(slide.objective, fixed.objective);
+  EXPECT_GT(slide.min_sj, 0.95 * fixed.min_sj);
+  EXPECT_GT(slide.min_ratio, 0.95 * fixed.min_ratio);
 }
 
 TEST(OptimizeSlide, OneAndTwoThreadsGiveTheSameBits) {
@@ -221,9 +232,12 @@ void optimise_into(Outcome& r, const BoundarySurface* surface, bool worst) {
   const std::vector<std::uint8_t> fixed = surface ? surface->fixed_mask() : fixed_mask(r.mesh, FixedVertices::boundary);
   OptimizeOptions o;
   o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface;
-  o.worst = worst;
+  o.worst = false;
   optimize_mesh(r.mesh, fixed, o);
+  // The shape stage's objective: the worst pass after it trades the mean for the minima (its
+  // ratio terms too), as in optimise() above.
   r.objective = shape_objective(r.mesh);
+  if (worst) improve_worst(r.mesh, fixed, o.worst_options);
   r.min_sj = 1;
   for (double q : scaled_jacobians(r.mesh)) {
     r.min_sj = std::min(r.min_sj, is_degenerate(q) ? -1.0 : q);
@@ -603,16 +617,26 @@ TEST(OptimizeSlide, BandOnTheInputBoundaryUntanglesTheEcrDragon) {
 // refused with the file and line, and nothing is written.
 TEST(OptimizeSlide, FixedIdsFromAFile) {
   const auto dir = scratch_dir();
-  const HexMesh in = slid_box(4, 0.8, 7);
+  const HexMesh in = slid_box(4, 0.4, 7);
   io::write_mesh(dir / "in.vtk", in);
   const auto boundary = boundary_vertex_mask(in);
+  // The free vertex must have only valid hexes around it: the shape stage holds the vertices
+  // of hexes that are not valid inside.
+  const MeshJacobians inside = mesh_jacobians(in);
+  const Incidence inc = vertex_hexes(in);
+  const auto all_valid = [&](Index v) {
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+      if (!inside.valid[inc.ids[k]]) return false;
+    return true;
+  };
   Index free_one = -1;
   {
     std::ofstream ids(dir / "ids.txt");
     ids << "# boundary vertices but one\n";
     for (Index v = 0; v < in.num_vertices(); ++v) {
       if (!boundary[v]) continue;
-      if (free_one < 0 && in.points[v].x() > 0 && in.points[v].x() < 1 && in.points[v].y() > 0 && in.points[v].y() < 1) {
+      if (free_one < 0 && in.points[v].x() > 0 && in.points[v].x() < 1 && in.points[v].y() > 0 && in.points[v].y() < 1 &&
+          all_valid(v)) {
         free_one = v;  // an inner vertex of the face z = 0 or 1
         continue;
       }

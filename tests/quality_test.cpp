@@ -23,10 +23,7 @@ namespace {
 
 using Corners = std::array<Vec3, 8>;
 
-Corners unit_cube() {
-  return {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0),
-          Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(1, 1, 1), Vec3(0, 1, 1)};
-}
+using isohex::test::unit_cube;
 
 /// Verdict's hex_test1 "regression" element (verdict.test.cpp).
 Corners hex_test1() {

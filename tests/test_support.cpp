@@ -41,6 +41,11 @@ Volume shared_volume(const std::string& file) {
   return read_volume(shared_data("volumes/" + file), opt);
 }
 
+std::array<Vec3, 8> unit_cube() {
+  return {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0),
+          Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(1, 1, 1), Vec3(0, 1, 1)};
+}
+
 fs::path scratch_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   fs::path dir = fs::path(ISOHEX_TEST_TMP) / (std::string(info->test_suite_name()) + "." + info->name());

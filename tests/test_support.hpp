@@ -4,6 +4,7 @@
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/volume/volume.hpp"
 
+#include <array>
 #include <filesystem>
 #include <string>
 
@@ -20,6 +21,9 @@ Volume shared_volume(const std::string& file);
 std::filesystem::path scratch_dir();
 /// An nx*ny*nz grid of unit-spaced hexes (spacing h), vertices numbered x fastest.
 HexMesh grid_mesh(int nx, int ny, int nz, double h = 1.0);
+
+/// The corners of the unit cube in VTK order.
+std::array<Vec3, 8> unit_cube();
 /// `path` in single quotes, for run_cli command lines.
 std::string quote(const std::filesystem::path& path);
 /// Runs the isohex CLI with `args` (a shell-quoted string); returns the exit code and

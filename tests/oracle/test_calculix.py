@@ -14,14 +14,14 @@ other end, *NODE PRINT of U); ccx must print "Job finished" and no *ERROR or *WA
   off, from below. The same 40 x 4 x 4 beam in metres (lengths x 1e-3), moved to negative
   coordinates below 0.01 in size, needs the writer's short spellings (".0123...", "1.2e-5")
   of its coordinates: its deflection must be the first one's x 1000 (to 1e-5).
-* With ISOHEX_CCX_PIPELINE=1 (or --pipeline): the meshes of `isohex mesh` on the headsq and
+* Unless ISOHEX_CCX_PIPELINE=0: the meshes of `isohex mesh` on the headsq and
   MR head rows of scripts/paper_table.py (its case list), written as .inp: the main part's
   bottom (z within 1 % of its height above its lowest node) clamped, a sideways load on its
   top (the same below its highest node), the small parts beside it held. The top's mean
   sideways motion must be positive (the load's work). The elements ccx refuses for a
   nonpositive Jacobian determinant must be those where numpy finds det J <= 0 at a 2 x 2 x 2
   Gauss point; they are listed, with how many are positive at all 8 corners (where the
-  scaled Jacobian looks). Off by default until the pipeline's meshes have none.
+  scaled Jacobian looks), and there must be none: ccx must finish the job.
 
 Exits 77 (ctest: skipped) without ccx; the pipeline cases skip without the shared data.
 """
@@ -271,6 +271,7 @@ def test_pipeline(cli, ccx, data, tmp):
         bad = at_gauss.min(axis=1) <= 0
         check(jacobians == ids[bad].tolist(),
               f"{name}: ccx's nonpositive Jacobians {jacobians} are numpy's at the Gauss points {ids[bad].tolist()}")
+        check(not jacobians and not bad.any(), f"{name}: every element has det J > 0 at its Gauss points")
         if bad.any():
             print(f"{name}: {int(bad.sum())} elements with det J <= 0 at {int((at_gauss[bad] <= 0).sum())} Gauss points, "
                   f"of which {int((at_corners[bad].min(axis=1) > 0).sum())} are positive at all 8 corners")
@@ -288,7 +289,7 @@ def main():
     ap.add_argument("--cli", required=True)
     ap.add_argument("--data", required=True)
     ap.add_argument("--tmp", required=True)
-    ap.add_argument("--pipeline", action="store_true", help="also the pipeline's meshes (ISOHEX_CCX_PIPELINE=1)")
+    ap.add_argument("--no-pipeline", action="store_true", help="the beam only (or ISOHEX_CCX_PIPELINE=0)")
     args = ap.parse_args()
     ccx = shutil.which("ccx")
     if ccx is None:
@@ -297,13 +298,13 @@ def main():
     shutil.rmtree(args.tmp, ignore_errors=True)
     os.makedirs(args.tmp)
     test_beam(args.cli, ccx, args.tmp)
-    if args.pipeline or os.environ.get("ISOHEX_CCX_PIPELINE") == "1":
+    if not args.no_pipeline and os.environ.get("ISOHEX_CCX_PIPELINE") != "0":
         if os.path.isdir(os.path.join(args.data, "volumes")):
             test_pipeline(args.cli, ccx, args.data, args.tmp)
         else:
             print("SKIP (pipeline meshes only): no shared data")
     else:
-        print("pipeline meshes not run (ISOHEX_CCX_PIPELINE=1 or --pipeline runs them)")
+        print("pipeline meshes not run (--no-pipeline or ISOHEX_CCX_PIPELINE=0)")
     if FAILURES:
         print(f"{len(FAILURES)} failures")
         return 1

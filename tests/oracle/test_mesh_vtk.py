@@ -296,7 +296,8 @@ def main():
             failures.append(f"{name}: isohex mesh exit {run.returncode}: {run.stdout[-800:]} {run.stderr}")
             continue
         report = json.load(open(rep))
-        chk = subprocess.run([args.cli, "check", out], capture_output=True, text=True)
+        # The raw extraction's topology (its inverted hexes are the untangler's to repair).
+        chk = subprocess.run([args.cli, "check", "--topology", out], capture_output=True, text=True)
         a, spacing, origin = via_cli_volume(args.cli, args.tmp, path, raw_args)
         rng = float(a.max() - a.min())
         edits = report["repair_edits"]

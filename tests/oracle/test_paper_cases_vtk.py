@@ -1,10 +1,14 @@
 #!/usr/bin/python3
 """The paper's cases through the whole pipeline, checked by VTK: `isohex mesh` with its defaults
 on the five default rows of scripts/paper_table.py (cthead, headsq, the head in a sphere,
-mAChE, the MR head) must leave no hex below 0.2 and none inverted. The scaled Jacobian is
+mAChE, the MR head) must leave no hex inverted and every hex valid inside: det J > 0 at the
+2x2x2 Gauss points by numpy (where a solver integrates) and `isohex check` (certified over the
+whole element) passing. Below 0.2 at most MAX_BELOW of the hexes: 0 is the target, but with
+validity inside certified cthead at h 4 keeps 8 of 81,823 (issue 15; they were 0 when the
+optimiser could buy Verdict's nine samples with folded interiors). The scaled Jacobian is
 VTK 9.1's vtkMeshQuality (Verdict), not the CLI's; the CLI's own count must agree with it.
-The mesh must also pass `isohex check` and have every released boundary vertex within the band
-(the CLI's report: `released_max_distance` at most 0.3 cells).
+Every released boundary vertex must be within the band (the CLI's report:
+`released_max_distance` at most 0.3 cells), and no vertex outside the domain.
 
 The case list is paper_table.py's (one list for the table and the test)."""
 import argparse
@@ -13,7 +17,29 @@ import os
 import subprocess
 import sys
 
+import numpy as np
+from vtk.util.numpy_support import vtk_to_numpy
+
 from vtk_support import hex_quality, read_vtu
+
+MAX_BELOW = 2e-4  # of the hexes
+
+
+def gauss_det_min(grid):
+    """The smallest det J of each hex at its 2x2x2 Gauss points (trilinear map, VTK order)."""
+    p = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
+    c = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
+    x = p[c]  # (hexes, 8, 3)
+    g = (1 - 1 / np.sqrt(3)) / 2
+    out = np.full(len(c), np.inf)
+    for u in (g, 1 - g):
+        for v in (g, 1 - g):
+            for w in (g, 1 - g):
+                xu = ((1-v)*(1-w)*(x[:, 1]-x[:, 0]) + v*(1-w)*(x[:, 2]-x[:, 3]) + (1-v)*w*(x[:, 5]-x[:, 4]) + v*w*(x[:, 6]-x[:, 7]))
+                xv = ((1-u)*(1-w)*(x[:, 3]-x[:, 0]) + u*(1-w)*(x[:, 2]-x[:, 1]) + (1-u)*w*(x[:, 7]-x[:, 4]) + u*w*(x[:, 6]-x[:, 5]))
+                xw = ((1-u)*(1-v)*(x[:, 4]-x[:, 0]) + u*(1-v)*(x[:, 5]-x[:, 1]) + u*v*(x[:, 6]-x[:, 2]) + (1-u)*v*(x[:, 7]-x[:, 3]))
+                out = np.minimum(out, np.einsum("ij,ij->i", xu, np.cross(xv, xw)))
+    return out
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
 import paper_table  # noqa: E402
@@ -46,15 +72,23 @@ def main():
             failures.append(f"{name}: isohex mesh exit {run.returncode}: {run.stdout[-600:]} {run.stderr[-300:]}")
             continue
         j = json.load(open(rep))
-        sj = hex_quality(read_vtu(out))
+        grid = read_vtu(out)
+        sj = hex_quality(grid)
+        gauss_bad = int((gauss_det_min(grid) <= 0).sum())
         below, inverted = int((sj < 0.2).sum()), int((sj < 0).sum())
         h = j["cell_size"]
         print(f"{name}: {len(sj)} hexes; VTK: min SJ {sj.min():.4f}, below 0.2 {below}, inverted {inverted}; "
               f"CLI: below 0.2 {j['scaled_jacobian']['questionable'] + j['scaled_jacobian']['inverted']}; "
-              f"released {j['released_vertices']} within {j['released_max_distance'] / h:.3f} cells; {j['seconds']:.1f} s",
+              f"released {j['released_vertices']} within {j['released_max_distance'] / h:.3f} cells; "
+              f"det J <= 0 at a Gauss point {gauss_bad}; not valid inside {j['validity']['not_valid_inside']}; "
+              f"jacobian ratio min {j['validity']['jacobian_ratio_min']:.3f}; {j['seconds']:.1f} s",
               flush=True)
-        if below or inverted:
+        if inverted or below > MAX_BELOW * len(sj):
             failures.append(f"{name}: {below} hexes below 0.2 ({inverted} inverted) by VTK's scaled Jacobian")
+        if gauss_bad:
+            failures.append(f"{name}: {gauss_bad} hexes with det J <= 0 at a Gauss point (numpy)")
+        if j["outside_domain_vertices"]:
+            failures.append(f"{name}: {j['outside_domain_vertices']} vertices outside the domain")
         if j["scaled_jacobian"]["questionable"] + j["scaled_jacobian"]["inverted"] != below:
             failures.append(f"{name}: the CLI's count below 0.2 differs from VTK's ({below})")
         if not j["valid"] or j["off_surface_vertices"] != 0:

@@ -81,6 +81,29 @@ Vec3 LevelSet::root(const Vec3& a, const Vec3& b) const {
   return a + std::clamp(t, 0.0, 1.0) * d;
 }
 
+bool LevelSet::project_on_face(Vec3& p, double max_distance, const LevelSet& plane) const {
+  if (plane.face_ < 0 || face_ >= 0) return false;
+  Vec3 q = p;
+  if (!plane.project(q, max_distance)) return false;
+  const int a = plane.face_ / 2;
+  const Vec3 start = q;
+  for (int it = 0; it < 40; ++it) {
+    Vec3 g;
+    const double l = level(q, g);
+    if (std::abs(l) <= tolerance_) {
+      if (!((q - p).norm() <= max_distance) || !plane.project(q, 0)) return false;  // still within the face
+      p = q;
+      return true;
+    }
+    g[a] = 0;
+    const double gg = g.squaredNorm();
+    if (!(gg > 0)) return false;
+    q -= (l / gg) * g;
+    if (!((q - start).norm() <= max_distance)) return false;
+  }
+  return false;
+}
+
 bool LevelSet::project(Vec3& p, double max_distance) const {
   if (face_ >= 0) {
     // Onto the plane exactly, and only within the face: past its edges lies another face.

@@ -55,6 +55,13 @@ class LevelSet {
   /// The unit of relative distances: the value range of an isosurface, a sphere's radius, a
   /// box's largest side.
   [[nodiscard]] double scale() const { return scale_; }
+  /// The box face (0–5) of a box-face level set, −1 for the others.
+  [[nodiscard]] int box_face() const { return face_; }
+  /// Moves `p` onto this surface and the plane of box face `plane` at once (their curve of
+  /// intersection, e.g. an isosurface's rim on the domain box), at most `max_distance` away:
+  /// onto the plane exactly, then Newton steps along the gradient's component in the plane.
+  /// True on success (|L| ≤ tolerance, p within the face).
+  bool project_on_face(Vec3& p, double max_distance, const LevelSet& plane) const;
   /// The isosurface's field, or null for a sphere or a box face.
   [[nodiscard]] const IsoField* field() const { return field_.get(); }
   /// "isosurface 1150 (inside above)", "sphere (...) radius R" or "box face z = 0".

@@ -2,6 +2,7 @@
 #include "isohex/optimize/local_energy.hpp"
 
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
@@ -17,9 +18,39 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// c_{t,k} for the 8 corner frames and the centre frame (principal axes / 4).
-std::array<std::array<Vec3, 8>, kFrames> make_coefficients() {
-  std::array<std::array<Vec3, 8>, kFrames> c;
+// ∇N_k at (u, v, w): the coefficient of corner k in the Jacobian matrix there.
+Vec3 shape_gradient(int k, double u, double v, double w) {
+  const bool x = k == 1 || k == 2 || k == 5 || k == 6, y = k == 2 || k == 3 || k == 6 || k == 7, z = k >= 4;
+  const double fu = x ? u : 1 - u, fv = y ? v : 1 - v, fw = z ? w : 1 - w;
+  return Vec3((x ? 1 : -1) * fv * fw, (y ? 1 : -1) * fu * fw, (z ? 1 : -1) * fu * fv);
+}
+
+// The parameters of the interior frames 9..34: Gauss points, edge midpoints, face centres.
+std::array<Vec3, kAllFrames - kFrames> interior_points() {
+  std::array<Vec3, kAllFrames - kFrames> q;
+  const double g = 0.21132486540518711775;  // (1 − 1/√3)/2
+  int n = 0;
+  for (int c = 0; c < 8; ++c) q[n++] = Vec3(c & 1 ? 1 - g : g, c & 2 ? 1 - g : g, c & 4 ? 1 - g : g);
+  for (int a = 0; a < 3; ++a)  // edges along axis a
+    for (int c = 0; c < 4; ++c) {
+      Vec3 x;
+      x[a] = 0.5;
+      x[(a + 1) % 3] = c & 1;
+      x[(a + 2) % 3] = (c >> 1) & 1;
+      q[n++] = x;
+    }
+  for (int a = 0; a < 3; ++a)  // faces normal to axis a
+    for (int side = 0; side < 2; ++side) {
+      Vec3 x(0.5, 0.5, 0.5);
+      x[a] = side;
+      q[n++] = x;
+    }
+  return q;
+}
+
+// c_{t,k} for the 8 corner frames, the centre frame (principal axes / 4) and the interior ones.
+std::array<std::array<Vec3, 8>, kAllFrames> make_coefficients() {
+  std::array<std::array<Vec3, 8>, kAllFrames> c;
   for (auto& row : c) row.fill(Vec3::Zero());
   for (int t = 0; t < 8; ++t) {
     c[t][t] = Vec3(-1, -1, -1);
@@ -31,9 +62,12 @@ std::array<std::array<Vec3, 8>, kFrames> make_coefficients() {
     const bool z = k >= 4;
     c[kCentreFrame][k] = 0.25 * Vec3(x ? 1 : -1, y ? 1 : -1, z ? 1 : -1);
   }
+  const auto q = interior_points();
+  for (int t = kFrames; t < kAllFrames; ++t)
+    for (int k = 0; k < 8; ++k) c[t][k] = shape_gradient(k, q[t - kFrames][0], q[t - kFrames][1], q[t - kFrames][2]);
   return c;
 }
-const std::array<std::array<Vec3, 8>, kFrames> kCoef = make_coefficients();
+const std::array<std::array<Vec3, 8>, kAllFrames> kCoef = make_coefficients();
 
 // The scalar derivatives of one frame's energy f(F, D), F = |A|², D = det A.
 struct Scalar {
@@ -80,7 +114,7 @@ Scalar shape_term(double F, double D) {
 Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
   const double F = A.squaredNorm(), D = A.determinant();
   if (params.untangle) return untangle_term(F, D, eps, params.lambda);
-  if (t == kCentreFrame) {  // the centre frame only constrains (validity), it is not optimised
+  if (t >= kCentreFrame) {  // the centre and interior frames only constrain (validity), they are not optimised
     Scalar r;
     if (!(D > kMinFeasibleDet)) r.f = kInf;
     return r;
@@ -91,6 +125,27 @@ Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
 }  // namespace
 
 const Vec3& frame_coefficient(int t, int k) { return kCoef[t][k]; }
+
+Vec3 frame_point(int t) {
+  if (t < 8) return Vec3(t == 1 || t == 2 || t == 5 || t == 6, t == 2 || t == 3 || t == 6 || t == 7, t >= 4);
+  if (t == kCentreFrame) return Vec3(0.5, 0.5, 0.5);
+  static const auto q = interior_points();
+  return q[static_cast<std::size_t>(t - kFrames)];
+}
+
+const std::array<int, 27>& lattice_frames() {
+  static const std::array<int, 27> map = [] {
+    std::array<int, 27> m;
+    m.fill(-1);
+    for (int t = 0; t < kAllFrames; ++t) {
+      const Vec3 x = 2 * frame_point(t);
+      const Vec3 r = x.array().round();
+      if ((x - r).norm() == 0) m[static_cast<std::size_t>(r[0] + 3 * r[1] + 9 * r[2])] = t;  // the Gauss points are not on it
+    }
+    return m;
+  }();
+  return map;
+}
 
 std::vector<double> inverse_edge_lengths(const HexMesh& mesh) {
   std::vector<double> inv(mesh.hexes.size());
@@ -110,6 +165,10 @@ Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   if (t < 8) {
     const auto& nb = kCornerNeighbors[t];
     for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
+  } else if (t >= kFrames) {
+    A.setZero();
+    for (int k = 0; k < 8; ++k) A += (p[k] - p[0]) * kCoef[t][k].transpose();  // Σ c_k = 0: relative to P0
+    A *= inv_len;
   } else {
     A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
     A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
@@ -118,16 +177,29 @@ Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   return A;
 }
 
-double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps) {
+double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps, int frames) {
   if (eps < 0) eps = params.eps;
   double e = 0;
-  for (int t = 0; t < kFrames; ++t) e += term(frame(p, t, inv_len), t, params, eps).f;
+  for (int t = 0; t < frames; ++t) e += term(frame(p, t, inv_len), t, params, eps).f;
   return e;
 }
 
 bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len) {
   for (int t = 0; t < kFrames; ++t)
     if (!(frame(p, t, inv_len).determinant() > kMinFeasibleDet)) return false;
+  return certified_valid(p, kMinFeasibleDet / (inv_len * inv_len * inv_len));
+}
+
+bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
+                    const Vec3& x, const std::vector<std::uint8_t>* skip) {
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const Index h = inc.ids[i];
+    if (skip && (*skip)[h]) continue;
+    std::array<Vec3, 8> p = mesh.corners(h);
+    for (int k = 0; k < 8; ++k)
+      if (mesh.hexes[h][k] == v) p[k] = x;
+    if (!hex_feasible(p, inv_len[h])) return false;
+  }
   return true;
 }
 
@@ -145,7 +217,8 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     p[k] = x;
     const double il = inv_len[h];
     const double eps = params.eps_of(h);
-    for (int t = 0; t < kFrames; ++t) {
+    const int frames = params.frames_of(h);
+    for (int t = 0; t < frames; ++t) {
       const Vec3& c = kCoef[t][k];
       if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
       const Mat3 A = frame(p, t, il);
@@ -208,7 +281,9 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
     Vec3 x = m.x + t * d;
     if (params.surface && !params.surface->put_back(v, x, n, len)) continue;
     const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
-    if (e < e0 && e <= e0 + 1e-4 * t * slope) {
+    // The shape stage's barrier sees the 9 frames only: a step must also keep every hex
+    // around v certified valid inside (hex_feasible()), or a fold could open between them.
+    if (e < e0 && e <= e0 + 1e-4 * t * slope && (params.untangle || stays_feasible(mesh, inc, inv_len, v, x, params.skip))) {
       m.x = x;
       m.moved = true;
       break;
@@ -222,7 +297,9 @@ double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, con
   std::vector<double> e(mesh.hexes.size(), 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h)
-      if (skip.empty() || !skip[h]) e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), inv_len[h], params, params.eps_of(static_cast<Index>(h)));
+      if (skip.empty() || !skip[h])
+        e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), inv_len[h], params, params.eps_of(static_cast<Index>(h)),
+                          params.frames_of(static_cast<Index>(h)));
   });
   double sum = 0;
   for (double x : e) sum += x;  // in hex order: the same bits for any thread count
@@ -257,7 +334,7 @@ double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc
 SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip) {
   SJStats s;
   s.min = 1.0;  // the scaled Jacobian's largest value: also the answer for no hexes
-  const std::vector<double> sj = scaled_jacobians(mesh);
+  const std::vector<double> sj = certified_scaled_jacobians(mesh);
   for (std::size_t h = 0; h < sj.size(); ++h) {
     if (skip && (*skip)[h]) continue;
     double v = sj[h];

@@ -26,6 +26,12 @@ using Mat3 = Eigen::Matrix3d;
 /// Frames 0..7 are the corner frames (Verdict's kCornerNeighbors), 8 the centre frame.
 inline constexpr int kFrames = 9;
 inline constexpr int kCentreFrame = 8;
+/// Frames 9..34 are Jacobian matrices inside the element: at the 8 Gauss points (2×2×2, where
+/// a solver evaluates det J), the 12 edge midpoints and the 6 face centres. With the corners
+/// and the centre they sample det J on the whole 3×3×3 lattice its Bernstein coefficients are
+/// made of. The untangler adds them for hexes that are not certified valid inside, so that its
+/// energy sees a fold that the 9 frames miss.
+inline constexpr int kAllFrames = 35;
 
 /// Below this normalised determinant a frame counts as inverted in the feasibility tests of
 /// the shape stage: a safety gap so that Verdict's own rounding can never see a negative sign.
@@ -45,9 +51,22 @@ struct EnergyParams {
   /// untangler freezes ε for hexes that have stopped improving, so that their frames (which
   /// would grow like 1/ε) cannot dominate the energy of the vertices they share with others.
   const std::vector<double>* hex_eps = nullptr;
+  /// Hexes whose energy also counts the interior frames 9..34 (may be null: none). In the
+  /// shape stage these frames only constrain (like the centre frame).
+  const std::vector<std::uint8_t>* interior = nullptr;
+  /// The number of frames hex h contributes.
+  int frames_of(Index h) const { return interior && (*interior)[static_cast<std::size_t>(h)] ? kAllFrames : kFrames; }
   /// ε of hex h under these parameters.
   double eps_of(Index h) const { return hex_eps ? std::max(eps, (*hex_eps)[static_cast<std::size_t>(h)]) : eps; }
 };
+
+/// The parameter point (u, v, w) of frame t.
+Vec3 frame_point(int t);
+
+/// The frames at the 27 points of the 3×3×3 lattice, in Bernstein order (index i + 3j + 9k for
+/// the point (i/2, j/2, k/2)): the Jacobian matrices whose determinants give det J's Bernstein
+/// coefficients (quality/jacobian_bounds.hpp).
+const std::array<int, 27>& lattice_frames();
 
 /// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
 std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
@@ -58,12 +77,19 @@ Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len);
 /// The coefficient c_{t,k} of corner k in frame t (zero when frame t does not use corner k).
 const Vec3& frame_coefficient(int t, int k);
 
-/// The energy of one hex under `params` (+inf if infeasible for the shape stage), the untangling
-/// energy with regularisation `eps` (params.eps when negative).
-double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps = -1);
+/// The energy of one hex's first `frames` frames under `params` (+inf if infeasible for the
+/// shape stage), the untangling energy with regularisation `eps` (params.eps when negative).
+double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps = -1,
+                  int frames = kFrames);
 
-/// True when all 9 frames of the hex have determinant > kMinFeasibleDet.
+/// True when all 9 frames of the hex have determinant > kMinFeasibleDet and the hex is
+/// certified valid inside with det J > kMinFeasibleDet · L³ everywhere (Bernstein bounds,
+/// certified_valid()): the validity every stage keeps.
 bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len);
+
+/// True when every hex around v (those flagged in `skip` left out) is hex_feasible() with v at x.
+bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
+                    const Vec3& x, const std::vector<std::uint8_t>* skip);
 
 /// The energy of the hexes around vertex v with v placed at x; with g and H, also its gradient
 /// and Hessian with respect to x (the Hessian of the regularised energy may be indefinite).
@@ -92,7 +118,8 @@ double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, con
 double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc, const std::vector<double>& inv_len,
              const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps = 1);
 
-/// Minimum scaled Jacobian (Verdict; degenerate counts as -1) and the number of hexes <= 0.
+/// Minimum certified scaled Jacobian (certified_scaled_jacobian(): Verdict's, 0 for a hex not
+/// certified valid inside; degenerate counts as -1) and the number of hexes <= 0.
 struct SJStats {
   double min = 0;
   std::size_t inverted = 0;

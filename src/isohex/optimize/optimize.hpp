@@ -36,7 +36,14 @@
 ///   must lower the objective, so the objective never increases.
 /// - improve_worst(): local max–min moves on the vertices of the worst hexes (an LP on the
 ///   linearised frame values of Verdict's scaled Jacobian), accepted only if the smallest of
-///   the values the vertex changes rises and Verdict's minimum around the vertex does not fall.
+///   the values the vertex changes rises, the certified minimum around the vertex does not
+///   fall, and the Bernstein bound of the jacobian ratio stays above WorstOptions::ratio_floor.
+///
+/// Valid means valid inside: every stage treats a hex as valid only when it is certified so by
+/// the Bernstein coefficients of det J (quality/jacobian_bounds.hpp), not by Verdict's nine
+/// samples, and no accepted move takes a certified hex out of that set. The untangler counts a
+/// hex that is not certified as inverted and adds interior frames (Gauss points, edge and face
+/// midpoints) to its energy.
 ///
 /// With a BoundarySurface (slide.hpp) in the options, its sliding boundary vertices move too:
 /// tangential steps, put back on the input's boundary surface or on an IsoField's isosurface
@@ -204,6 +211,14 @@ struct WorstOptions {
   double target = 0.6;  ///< a vertex whose frame values are all at least this is not moved
   /// No move may make an edge shorter than this fraction of its length when the pass began.
   double min_edge_shrink = 0.5;
+  /// No move may lower the smallest jacobian_ratio_bound() of the hexes around the vertex
+  /// below the lower of its value before and this: the nine samples of the scaled Jacobian
+  /// are not bought with a distorted interior.
+  double ratio_floor = 0.2;
+  /// The max–min moves also raise the Bernstein coefficients of det J over each hex's largest
+  /// (a lower bound of its jacobian ratio, weighted 2: a ratio of 0.1 counts as a scaled
+  /// Jacobian of 0.2), and the worst hexes are chosen by the lower of the two.
+  bool ratio_terms = true;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };

@@ -60,17 +60,36 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, std::vector<contour::Level
 void BoundarySurface::assign_targets(const HexMesh& mesh, const std::vector<std::int8_t>& place,
                                      const std::vector<std::uint8_t>* pin) {
   // A vertex slides only on its own surface, and only when it is on it and on no other: where
-  // two surfaces meet (a box's edges, a rim) it could slide along neither without cutting the
-  // other's corner off the domain.
+  // two surfaces meet (a box's edges) it could slide along neither without cutting the other's
+  // corner off the domain. The exception is a rim, a curved surface on one box face: there the
+  // vertex slides along their curve of intersection, on both at once.
   target_.assign(role_.size(), -1);
+  face_.assign(role_.size(), -1);
   for (std::size_t v = 0; v < role_.size(); ++v) {
     if (role_[v] != static_cast<std::uint8_t>(Role::slides)) continue;
     const int k = v < place.size() ? place[v] : -1;
     bool slides = k >= 0 && static_cast<std::size_t>(k) < surfaces_.size() && !(pin && v < pin->size() && (*pin)[v] != 0) &&
                   surfaces_[static_cast<std::size_t>(k)].on(mesh.points[v]);
-    for (std::size_t j = 0; slides && j < surfaces_.size(); ++j) slides = j == static_cast<std::size_t>(k) || !surfaces_[j].on(mesh.points[v]);
-    if (slides) target_[v] = static_cast<std::int8_t>(k);
-    else role_[v] = static_cast<std::uint8_t>(Role::pinned);
+    std::vector<int> others;
+    for (std::size_t j = 0; slides && j < surfaces_.size(); ++j)
+      if (j != static_cast<std::size_t>(k) && surfaces_[j].on(mesh.points[v])) others.push_back(static_cast<int>(j));
+    // A rim: a curved surface and one box face. The vertex slides on the curved one and
+    // keeps to the plane (whichever of the two its place names).
+    int target = k, face = -1;
+    if (slides && others.size() == 1) {
+      const contour::LevelSet &a = surfaces_[static_cast<std::size_t>(k)], &b = surfaces_[static_cast<std::size_t>(others[0])];
+      if (a.box_face() < 0 && b.box_face() >= 0) face = others[0];
+      else if (a.box_face() >= 0 && b.box_face() < 0) target = others[0], face = k;
+      slides = face >= 0;
+    } else if (!others.empty()) {
+      slides = false;
+    }
+    if (slides) {
+      target_[v] = static_cast<std::int8_t>(target);
+      face_[v] = static_cast<std::int8_t>(face);
+    } else {
+      role_[v] = static_cast<std::uint8_t>(Role::pinned);
+    }
   }
   sliding_ = pinned_ = 0;
   for (std::uint8_t r : role_) {
@@ -105,7 +124,8 @@ bool BoundarySurface::reproject(Index v, Vec3& x, const Vec3& n, double len) con
   }
   if (target(v) < 0) return false;
   Vec3 p = x;
-  if (!surfaces_[target(v)].project(p, len)) return false;
+  const contour::LevelSet& s = surfaces_[target(v)];
+  if (!(on_face(v) >= 0 ? s.project_on_face(p, len, surfaces_[on_face(v)]) : s.project(p, len))) return false;
   x = p;
   return true;
 }
@@ -153,19 +173,26 @@ bool BoundarySurface::foot_point(Index v, const Vec3& x, double max_reach, Vec3&
   }
 }
 
-bool BoundarySurface::band_clamp(Index v, Vec3& x, double len) const {
-  // Box first, then band: the foot point is in the box, so the segment from it to x is too.
-  if (has_domain_) x = x.cwiseMax(domain_.lo).cwiseMin(domain_.hi);
+bool BoundarySurface::band_clamp(Index v, Vec3& x, double /*len*/) const {
+  // Box, then band, then the box again: the foot point need not be in the box (an isosurface
+  // goes on past the domain's faces), so the step to the band's edge may leave it.
+  const auto clamp = [&] {
+    if (has_domain_) x = x.cwiseMax(domain_.lo).cwiseMin(domain_.hi);
+  };
+  clamp();
   // The projection follows the gradient, not the straight line to the nearest point, so the
   // foot seen from the clamped point can differ a little: a few rounds settle it, and a step
   // whose foot does not settle is refused.
   Vec3 foot;
   for (int round = 0; round < 5; ++round) {
-    if (!foot_point(v, x, round == 0 ? len + band_ : kFootReach * band_, foot)) return false;
+    // The same reaches as offset(): a wider first reach (a long step) could find another foot
+    // than offset() later does from the same point, and the band would not hold as measured.
+    if (!foot_point(v, x, kFootReach * band_, foot)) return false;
     const Vec3 d = x - foot;
     const double dn = d.norm();
     if (!(dn > band_ * (1 + 1e-6))) return true;
     x = foot + d * (band_ / dn);
+    clamp();
   }
   return false;
 }

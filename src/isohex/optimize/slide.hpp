@@ -18,6 +18,9 @@
 /// surface. Pinned: boundary vertices whose place is no surface, those not on it at
 /// construction (LevelSet::on), those also on another of the surfaces (where two meet:
 /// a crease, e.g. a box's edges), feature vertices, and those of an optional extra mask.
+/// Except the rim where a curved surface (an isosurface, a sphere) meets one box face: its
+/// vertices slide along that curve (on_face()), so that two of them that extraction put next
+/// to each other (edges of 1e-6 cells) can move apart.
 /// The IsoField form is the one-surface case (every boundary vertex's place is the isosurface).
 
 #include "isohex/contour/iso_field.hpp"
@@ -52,6 +55,9 @@ class BoundarySurface {
   [[nodiscard]] const std::vector<contour::LevelSet>& surfaces() const { return surfaces_; }
   /// The index into surfaces() of sliding vertex v's target, or −1 (not sliding, or triangles).
   [[nodiscard]] int target(Index v) const { return v < static_cast<Index>(target_.size()) ? target_[v] : -1; }
+  /// The box face (an index into surfaces()) whose plane sliding vertex v also keeps to: a
+  /// rim vertex slides along the curve where its target meets that plane. −1 for the others.
+  [[nodiscard]] int on_face(Index v) const { return v < static_cast<Index>(face_.size()) ? face_[v] : -1; }
   /// How many vertices slide on surfaces()[k].
   [[nodiscard]] std::size_t num_sliding_on(std::size_t k) const;
   /// The unit normal of v's target surface at (or, for the triangles, nearest to) x, in `n`;
@@ -76,9 +82,10 @@ class BoundarySurface {
   /// The box loose vertices must stay in (the domain: a band must not carry them out of it).
   void set_domain(const Aabb& box) { domain_ = box; has_domain_ = true; }
   /// Puts x, a step of loose vertex v (local edge length `len`), back within the band: into the
-  /// domain box if one is set, then x's foot point on v's target (the level set's projection, or the nearest triangle point) and,
-  /// if x is farther than the band from it, the point at the band's distance towards x. False
-  /// when the foot point cannot be found: the step must then be refused.
+  /// domain box if one is set, then x's foot point on v's target (the level set's projection,
+  /// or the nearest triangle point) and, if x is farther than the band from it, the point at
+  /// the band's distance towards x, into the box again, a few rounds. False when the foot point
+  /// cannot be found or does not settle: the step must then be refused.
   bool band_clamp(Index v, Vec3& x, double len) const;
   /// Puts x, a step of v from a point whose tangent-plane normal is `n`, back where v's role
   /// allows: reproject() for a sliding vertex, band_clamp() for a loose one, unchanged for the
@@ -124,6 +131,7 @@ class BoundarySurface {
   std::vector<std::uint8_t> role_;
   std::vector<contour::LevelSet> surfaces_;
   std::vector<std::int8_t> target_;  // per vertex: index into surfaces_, −1 unless sliding on one
+  std::vector<std::int8_t> face_;    // per vertex: the box face a rim vertex keeps to, or −1
   std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
   double band_ = 0;
   Aabb domain_{Vec3::Zero(), Vec3::Zero()};

@@ -4,6 +4,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -15,15 +16,17 @@ namespace isohex {
 
 namespace {
 
-// The smallest normalised frame determinant of each hex (+1e300 for skipped hexes).
+// The smallest normalised frame determinant of each hex (+1e300 for skipped hexes), over the
+// frames its energy counts.
 std::vector<double> hex_min_det(const HexMesh& mesh, const std::vector<double>& inv_len,
-                                const std::vector<std::uint8_t>* skip) {
+                                const std::vector<std::uint8_t>* skip, const opt::EnergyParams& params) {
   std::vector<double> d(mesh.hexes.size(), 1e300);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h) {
       if (skip && (*skip)[h]) continue;
       const auto p = mesh.corners(static_cast<Index>(h));
-      for (int t = 0; t < opt::kFrames; ++t) d[h] = std::min(d[h], opt::frame(p, t, inv_len[h]).determinant());
+      const int frames = params.frames_of(static_cast<Index>(h));
+      for (int t = 0; t < frames; ++t) d[h] = std::min(d[h], opt::frame(p, t, inv_len[h]).determinant());
     }
   });
   return d;
@@ -55,7 +58,7 @@ double chi(double D, double eps) {
 std::size_t lp_rescue(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc,
                       const std::vector<double>& inv_len, const std::vector<std::uint8_t>* skip,
                       const BoundarySurface* surface) {
-  const std::vector<double> sj = scaled_jacobians(mesh);
+  const std::vector<double> sj = certified_scaled_jacobians(mesh);
   std::vector<std::uint8_t> active(mesh.points.size(), 0);
   for (Index h = 0; h < mesh.num_hexes(); ++h)
     if ((!skip || !(*skip)[h]) && (sj[h] <= 0 || is_degenerate(sj[h])))
@@ -113,13 +116,15 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     res.min_sj = s.min;
     res.iterations = iterations;
     res.inverted = skipped ? opt::sj_stats(mesh).inverted : s.inverted;
-    const std::vector<double> sj = scaled_jacobians(mesh);
+    const std::vector<double> sj = certified_scaled_jacobians(mesh);
     for (Index h = 0; h < mesh.num_hexes(); ++h)
       if (hex_eps[h] > 0 && (sj[h] <= 0 || is_degenerate(sj[h]))) res.stuck.push_back(h);
     return res;
   };
 
-  std::vector<double> sj = scaled_jacobians(mesh);
+  // "Valid" means certified valid inside (certified_scaled_jacobians(): 0 for a hex whose nine
+  // samples are positive but that folds inside), so the untangler works on such hexes too.
+  std::vector<double> sj = certified_scaled_jacobians(mesh);
   opt::SJStats stats = stats_of(sj, skipped);
   if (stats.min >= options.margin) {
     res.reached_margin = true;
@@ -130,7 +135,10 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   const Incidence inc = vertex_hexes(mesh);
   const VertexColoring coloring = color_vertices(mesh, fixed);
   const std::vector<double> inv_len = opt::inverse_edge_lengths(mesh);
-  opt::EnergyParams params{true, 1.0, options.lambda, skipped, options.surface, &hex_eps};
+  // Hexes that have not been valid inside count their interior frames too (from the first
+  // time they are seen so, to the end): the 9 frames alone cannot see their fold.
+  std::vector<std::uint8_t> interior(mesh.hexes.size(), 0);
+  opt::EnergyParams params{true, 1.0, options.lambda, skipped, options.surface, &hex_eps, &interior};
   const std::vector<std::uint8_t> no_skip;
   const std::vector<std::uint8_t>& energy_skip = skipped ? skip : no_skip;
   // Per hex: the best (highest) smallest frame determinant seen while inverted, and when.
@@ -151,11 +159,13 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   opt::SJStats best = stats;
   res.stop = "max_iter";
   for (int it = 1; it <= options.max_iter; ++it) {
+    for (std::size_t h = 0; h < sj.size(); ++h)
+      if (sj[h] <= 0 || is_degenerate(sj[h])) interior[h] = 1;
     const double e_before = opt::total_energy(mesh, inv_len, params, energy_skip);
     const std::vector<std::uint8_t> frozen = frozen_outside(mesh, inc, sj, options.margin, options.rings, skipped);
     for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2);
     const double e_after = opt::total_energy(mesh, inv_len, params, energy_skip);
-    sj = scaled_jacobians(mesh);
+    sj = certified_scaled_jacobians(mesh);
     stats = stats_of(sj, skipped);
     iterations = it;
     if (options.progress) options.progress({"untangle", it, e_after / (9.0 * mesh.num_hexes()), stats.min, stats.inverted});
@@ -174,7 +184,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     // D < 0) dominate every vertex they share, crushing the valid neighbours for nothing, and
     // blow the energy up; they also leave the ε schedule. A stuck hex that becomes valid again
     // is released.
-    const std::vector<double> hdet = hex_min_det(mesh, inv_len, skipped);
+    const std::vector<double> hdet = hex_min_det(mesh, inv_len, skipped, params);
     double dmin = 1e300;
     for (Index h = 0; h < mesh.num_hexes(); ++h) {
       if (skipped && skip[h]) continue;
@@ -230,7 +240,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
         best_points = mesh.points;
         stats = after;
         best_inverted = std::min(best_inverted, after.inverted);
-        sj = scaled_jacobians(mesh);
+        sj = certified_scaled_jacobians(mesh);
         since_progress = 0;  // a new window from here
       }
     }

@@ -5,6 +5,7 @@
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 #include "isohex/quality/summary.hpp"
 
 #include <algorithm>
@@ -15,9 +16,10 @@ namespace isohex {
 
 namespace {
 
-// Degenerate (collapsed) hexes rank below every real value.
+// Degenerate (collapsed) hexes rank below every real value; a hex that is not certified valid
+// inside counts as 0 at best, whatever its nine samples say.
 double sj_value(const std::array<Vec3, 8>& p) {
-  const double v = scaled_jacobian(p);
+  const double v = certified_scaled_jacobian(p);
   return is_degenerate(v) ? -2.0 : v;
 }
 
@@ -26,11 +28,15 @@ double sj_value(const std::array<Vec3, 8>& p) {
 // v is shorter than `shrink` times its length in `start` (the mesh when the pass began): the
 // scaled Jacobian is blind to edge lengths, so a max–min ascent alone may shrink an edge
 // towards zero (on a sphere's mesh it drove the mean inverse mean ratio from 1.3 to 81).
+// With `ratio`, also the smallest jacobian_ratio_bound() of those hexes: the scaled Jacobian
+// samples det J at nine points, so the pass must not buy them with a distorted interior.
 double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool* valid = nullptr,
-                 int* questionable = nullptr, const std::vector<Vec3>* start = nullptr, double shrink = 0) {
+                 int* questionable = nullptr, const std::vector<Vec3>* start = nullptr, double shrink = 0,
+                 double* ratio = nullptr) {
   double lo = 2.0;
   if (valid) *valid = true;
   if (questionable) *questionable = 0;
+  if (ratio) *ratio = 1.0;
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     auto p = mesh.corners(h);
@@ -38,6 +44,7 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
       if (mesh.hexes[h][k] == v) p[k] = x;
     const double q = sj_value(p);
     lo = std::min(lo, q);
+    if (ratio) *ratio = std::min(*ratio, jacobian_ratio_bound(p));
     if (questionable) *questionable += q < kQuestionableSJ;
     if (!valid) continue;
     if (q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
@@ -54,10 +61,54 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
 // The scaled Jacobians of the frames (of the hexes around v) that v's position changes, each
 // as its value and gradient in that position: det[a b c] / (|a| |b| |c|), the columns of
 // opt::frame(). Verdict's hex value is the minimum of these and of the frames v is not in.
-// With `value_only`, the gradients are left zero.
+// With `value_only`, the gradients are left zero; with `ratio`, ratio_terms() come too.
+// The Bernstein coefficients of det J of each hex around v, divided by that hex's largest one
+// as the mesh stands (a constant of the move), as affine functions of v's place: each lattice
+// determinant is affine in one vertex (matrix determinant lemma) and the coefficients are
+// fixed combinations of them. Their minimum bounds the hex's jacobian ratio from below, so a
+// max–min move on them raises the element's interior, not only Verdict's nine samples. The
+// weight 2 puts a ratio of 0.1 (poor, kPoorJacobianRatio) level with a scaled Jacobian of 0.2.
+// Weighted by kRatioWeight against the scaled Jacobian's frame values.
+constexpr double kRatioWeight = 2;
+
+void ratio_terms(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool value_only,
+                 std::vector<opt::Affine>& out) {
+  constexpr double weight = kRatioWeight;
+  const std::array<int, 27>& lattice = opt::lattice_frames();
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const Index h = inc.ids[i];
+    auto p = mesh.corners(h);
+    const std::array<double, 27> now = jacobian_bernstein(p);
+    const double m = *std::max_element(now.begin(), now.end());
+    if (!(m > 0)) continue;
+    int k = 0;
+    while (mesh.hexes[h][k] != v) ++k;
+    p[k] = x;
+    std::array<opt::Affine, 27> f;
+    for (int n = 0; n < 27; ++n) {
+      const int t = lattice[static_cast<std::size_t>(n)];
+      const opt::Mat3 A = opt::frame(p, t, 1.0);
+      f[n].b = weight * A.determinant() / m;
+      if (!value_only) f[n].a = (weight / m) * opt::det_gradient(A, opt::frame_coefficient(t, k));
+    }
+    // Values at 0, 1/2, 1 to quadratic Bernstein coefficients along each axis (linear, so the
+    // gradients transform alike).
+    const auto to_bernstein = [&](int a, int b, int c) {
+      f[b].b = 2 * f[b].b - 0.5 * (f[a].b + f[c].b);
+      f[b].a = 2 * f[b].a - 0.5 * (f[a].a + f[c].a);
+    };
+    for (int q = 0; q < 9; ++q) to_bernstein(3 * q, 3 * q + 1, 3 * q + 2);
+    for (int l = 0; l < 3; ++l)
+      for (int i2 = 0; i2 < 3; ++i2) to_bernstein(i2 + 9 * l, i2 + 3 + 9 * l, i2 + 6 + 9 * l);
+    for (int q = 0; q < 9; ++q) to_bernstein(q, q + 9, q + 18);
+    out.insert(out.end(), f.begin(), f.end());
+  }
+}
+
 std::vector<opt::Affine> frame_values(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x,
-                                      bool value_only = false) {
+                                      bool value_only, bool ratio) {
   std::vector<opt::Affine> out;
+  if (ratio) ratio_terms(mesh, inc, v, x, value_only, out);
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     auto p = mesh.corners(h);
@@ -106,7 +157,9 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
                  const BoundarySurface* surface, const WorstOptions& options) {
   const Vec3 x0 = mesh.points[v];
   int below0 = 0;
-  const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0);
+  double ratio0 = 1;
+  const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0, nullptr, 0, &ratio0);
+  const double ratio_floor = std::min(ratio0, options.ratio_floor);
   const double len = opt::mean_edge_at(mesh, inc, v);
   if (!(len > 0)) return false;
   const bool slides = surface && surface->role(v) == BoundarySurface::Role::slides;
@@ -114,7 +167,7 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
   double box = options.step * len;
   bool moved = false;
   for (int model = 0; model < options.models; ++model) {
-    std::vector<opt::Affine> f = frame_values(mesh, inc, v, x);
+    std::vector<opt::Affine> f = frame_values(mesh, inc, v, x, false, options.ratio_terms);
     const double now = lowest(f);
     // Frames at the target are good enough: no move there, and the model seeks no more (a
     // constant frame at the target caps the LP's bound), so the max–min step does not flatten
@@ -139,10 +192,13 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
       if (surface && !surface->put_back(v, y, n, len)) continue;  // off the surface (or band): refused
       bool valid = false;
       int below = 0;
+      double ratio = 1;
       // A negative local minimum may rise while a valid neighbour is inverted on the way;
       // raising one hex by bending several others below 0.2 is no gain.
-      const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink);
-      if (!valid || below > below0 || q < m0 || !(lowest(frame_values(mesh, inc, v, y, true)) > now + 1e-9)) continue;
+      const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio);
+      if (!valid || below > below0 || q < m0 || ratio < ratio_floor ||
+          !(lowest(frame_values(mesh, inc, v, y, true, options.ratio_terms)) > now + 1e-9))
+        continue;
       x = y;
       gained = moved = true;
     }
@@ -160,7 +216,15 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   WorstResult res;
   const Incidence inc = vertex_hexes(mesh);
   std::vector<double> sj(mesh.hexes.size());
-  for (Index h = 0; h < mesh.num_hexes(); ++h) sj[h] = sj_value(mesh.corners(h));
+  // The pass works on the hexes lowest in `rank`: the scaled Jacobian, or with ratio_terms the
+  // lower of it and the hex's Bernstein ratio bound.
+  std::vector<double> rank(mesh.hexes.size());
+  const auto update = [&](Index h) {
+    const auto p = mesh.corners(h);
+    sj[h] = sj_value(p);
+    rank[h] = options.ratio_terms ? std::min(sj[h], kRatioWeight * jacobian_ratio_bound(p)) : sj[h];
+  };
+  for (Index h = 0; h < mesh.num_hexes(); ++h) update(h);
   const auto mesh_min = [&] { return sj.empty() ? 1.0 : *std::min_element(sj.begin(), sj.end()); };
   res.min_sj_before = res.min_sj_after = mesh_min();
   std::vector<Index> order(mesh.hexes.size());
@@ -170,17 +234,17 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     // Sequential and in a fixed order (worst first, ties by id): deterministic, and cheap
     // since only a few hundred vertices take part.
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return sj[a] < sj[b]; });
+    std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return rank[a] < rank[b]; });
     std::size_t moved = 0;
     for (std::size_t i = 0;
-         i < order.size() && ((i < options.count && sj[order[i]] < options.below) || sj[order[i]] < options.raise_below);
+         i < order.size() && ((i < options.count && rank[order[i]] < options.below) || rank[order[i]] < options.raise_below);
          ++i) {
       for (Index v : mesh.hexes[order[i]]) {
         if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
         seen[v] = pass;
         if (!move_vertex(mesh, inc, v, start, options.surface, options)) continue;
         ++moved;
-        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) sj[inc.ids[k]] = sj_value(mesh.corners(inc.ids[k]));
+        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
       }
     }
     res.passes = pass;

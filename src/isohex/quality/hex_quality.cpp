@@ -2,6 +2,7 @@
 #include "isohex/quality/hex_quality.hpp"
 
 #include "isohex/error.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 namespace isohex {
 
@@ -15,6 +16,8 @@ std::string_view metric_name(HexMetric m) {
     case HexMetric::skew: return "skew";
     case HexMetric::taper: return "taper";
     case HexMetric::volume: return "volume";
+    case HexMetric::jacobian_ratio: return "jacobian_ratio";
+    case HexMetric::gauss_jacobian: return "gauss_jacobian";
   }
   throw Error("unknown hex metric");
 }
@@ -35,6 +38,8 @@ double hex_metric(HexMetric m, const std::array<Vec3, 8>& p) {
     case HexMetric::skew: return skew(p);
     case HexMetric::taper: return taper(p);
     case HexMetric::volume: return volume(p);
+    case HexMetric::jacobian_ratio: return jacobian_ratio(p);
+    case HexMetric::gauss_jacobian: return gauss_min_jacobian(p);
   }
   throw Error("unknown hex metric");
 }

@@ -61,12 +61,16 @@ enum class HexMetric {
   skew,             ///< Verdict hex_skew
   taper,            ///< Verdict hex_taper
   volume,           ///< Verdict hex_volume
+  jacobian_ratio,   ///< certified min det J / max det J over the whole element (Gmsh's minJ/maxJ;
+                    ///< jacobian_bounds.hpp): <= 0 unless the element is valid inside
+  gauss_jacobian,   ///< the smallest det J at the 2×2×2 Gauss points (a C3D8 solver's view; length^3)
 };
 
 /// All metrics, in enum order.
-inline constexpr std::array<HexMetric, 8> kAllHexMetrics = {
-    HexMetric::scaled_jacobian, HexMetric::jacobian, HexMetric::edge_ratio, HexMetric::mean_ratio,
-    HexMetric::shape,           HexMetric::skew,     HexMetric::taper,      HexMetric::volume};
+inline constexpr std::array<HexMetric, 10> kAllHexMetrics = {
+    HexMetric::scaled_jacobian, HexMetric::jacobian, HexMetric::edge_ratio,     HexMetric::mean_ratio,
+    HexMetric::shape,           HexMetric::skew,     HexMetric::taper,          HexMetric::volume,
+    HexMetric::jacobian_ratio,  HexMetric::gauss_jacobian};
 
 /// The CLI name of a metric ("scaled_jacobian", "edge_ratio", ...).
 std::string_view metric_name(HexMetric m);

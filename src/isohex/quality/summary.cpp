@@ -1,5 +1,8 @@
 #include "isohex/quality/summary.hpp"
 
+#include "isohex/quality/jacobian_bounds.hpp"
+
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 
@@ -22,7 +25,7 @@ namespace {
 
 Histogram make_histogram(HexMetric m, const std::vector<double>& values, double lo, double hi) {
   Histogram h;
-  if (m == HexMetric::scaled_jacobian) {
+  if (m == HexMetric::scaled_jacobian || m == HexMetric::jacobian_ratio) {
     for (int i = -10; i <= 10; ++i) h.edges.push_back(i / 10.0);
   } else {
     if (!(hi > lo)) hi = lo + 1;  // one value (or none): a unit-wide range around it
@@ -67,6 +70,9 @@ MetricSummary summarize(HexMetric m, const std::vector<double>& values, std::siz
     if (m == HexMetric::scaled_jacobian) {
       if (v < 0) ++s.inverted;
       else if (v < kQuestionableSJ) ++s.questionable;
+    } else if (m == HexMetric::jacobian_ratio) {
+      if (v <= 0) ++s.inverted;
+      else if (v < kPoorJacobianRatio) ++s.questionable;
     }
   }
   const std::size_t good = s.count - s.degenerate;
@@ -125,6 +131,10 @@ nlohmann::json to_json(const MetricSummary& s) {
     j["inverted"] = s.inverted;
     j["questionable"] = s.questionable;
     j["questionable_threshold"] = kQuestionableSJ;
+  } else if (s.metric == HexMetric::jacobian_ratio) {
+    j["not_valid_inside"] = s.inverted;
+    j["poor"] = s.questionable;
+    j["poor_threshold"] = kPoorJacobianRatio;
   }
   j["histogram"] = {{"edges", s.histogram.edges},
                     {"counts", s.histogram.counts},
@@ -134,6 +144,39 @@ nlohmann::json to_json(const MetricSummary& s) {
   for (const auto& e : s.worst) w.push_back({{"id", e.id}, {"value", e.value}});
   j["worst"] = w;
   return j;
+}
+
+ValiditySummary summarize_validity(const HexMesh& mesh, std::size_t keep) {
+  const MeshJacobians mj = mesh_jacobians(mesh);
+  ValiditySummary s;
+  s.hexes = mj.valid.size();
+  for (std::size_t h = 0; h < mj.valid.size(); ++h) {
+    s.gauss_nonpositive += !(mj.gauss_min[h] > 0);
+    s.min_ratio = std::min(s.min_ratio, mj.ratio[h]);
+    if (mj.valid[h]) {
+      s.poor += mj.ratio[h] < kPoorJacobianRatio;
+      continue;
+    }
+    if (s.not_valid_inside++ < keep) s.invalid.push_back(static_cast<Index>(h));
+  }
+  return s;
+}
+
+std::string describe(const ValiditySummary& s) {
+  return fmt::format("validity inside (certified Bernstein bounds of det J): {} of {} hexes not valid inside, {} with "
+                     "det J <= 0 at a Gauss point; jacobian ratio min {:.4g}; valid inside with a ratio below {}: {}",
+                     s.not_valid_inside, s.hexes, s.gauss_nonpositive, s.min_ratio, kPoorJacobianRatio, s.poor);
+}
+
+nlohmann::json to_json(const ValiditySummary& s) {
+  return {{"hexes", s.hexes},
+          {"certified_valid", s.hexes - s.not_valid_inside},
+          {"not_valid_inside", s.not_valid_inside},
+          {"not_valid_inside_hexes", s.invalid},
+          {"gauss_nonpositive", s.gauss_nonpositive},
+          {"jacobian_ratio_min", s.min_ratio},
+          {"jacobian_ratio_poor", s.poor},
+          {"poor_threshold", kPoorJacobianRatio}};
 }
 
 }  // namespace isohex

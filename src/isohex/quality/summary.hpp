@@ -16,6 +16,9 @@ namespace isohex {
 
 /// Threshold below which the paper (and isohex) calls an element questionable.
 inline constexpr double kQuestionableSJ = 0.2;
+/// Below this jacobian ratio (min det J / max det J) an element that is valid inside is counted
+/// as poor (Gmsh's minJ/maxJ; solvers' elements lose accuracy long before it reaches 0).
+inline constexpr double kPoorJacobianRatio = 0.1;
 
 /// True if larger values of `m` mean better elements.
 bool higher_is_better(HexMetric m);
@@ -40,14 +43,15 @@ struct MetricSummary {
   std::size_t count = 0;        ///< elements
   std::size_t degenerate = 0;   ///< Verdict's 1e30 marker: never counted as good
   double min = 0, max = 0, mean = 0;  ///< over the non-degenerate elements
-  std::size_t inverted = 0;     ///< scaled Jacobian < 0 (scaled_jacobian only)
-  std::size_t questionable = 0; ///< 0 <= scaled Jacobian < 0.2 (scaled_jacobian only)
+  std::size_t inverted = 0;     ///< scaled Jacobian < 0; jacobian_ratio <= 0 (not valid inside)
+  std::size_t questionable = 0; ///< 0 <= scaled Jacobian < 0.2; 0 < jacobian_ratio < 0.1
   Histogram histogram;
   std::vector<ElementValue> worst;  ///< worst first; degenerate elements lead
 };
 
 /// Summarises `values` (one per hex) of metric `m`, keeping the `worst` worst elements.
-/// The scaled Jacobian uses the paper's fixed bins (width 0.1 over [-1, 1]); other metrics
+/// The scaled Jacobian and the jacobian ratio use the paper's fixed bins (width 0.1 over
+/// [-1, 1]); other metrics
 /// 20 equal bins over [min, max]. Sequential sums keep the mean identical for any thread count.
 MetricSummary summarize(HexMetric m, const std::vector<double>& values, std::size_t worst = 10);
 
@@ -64,6 +68,21 @@ QuadSummary summarize_quads(const HexMesh& mesh, const std::vector<Quad>& quads)
 
 /// JSON object of a summary (histogram and worst elements included).
 nlohmann::json to_json(const MetricSummary& s);
+
+/// Validity over the whole element (jacobian_bounds.hpp), counted over a mesh.
+struct ValiditySummary {
+  std::size_t hexes = 0;
+  std::size_t not_valid_inside = 0;   ///< not certified valid inside (det J > 0 everywhere)
+  std::size_t gauss_nonpositive = 0;  ///< det J <= 0 at one of the 2×2×2 Gauss points
+  std::size_t poor = 0;               ///< valid inside, jacobian ratio below kPoorJacobianRatio
+  double min_ratio = 1;               ///< the smallest jacobian ratio (1 for no hexes)
+  std::vector<Index> invalid;         ///< the first `keep` hexes not valid inside (ascending)
+};
+/// Counts mesh_jacobians() of `mesh`, keeping up to `keep` ids of hexes not valid inside.
+ValiditySummary summarize_validity(const HexMesh& mesh, std::size_t keep = 20);
+/// One line: "validity inside: N not valid inside, G with det J <= 0 at a Gauss point, ...".
+std::string describe(const ValiditySummary& s);
+nlohmann::json to_json(const ValiditySummary& s);
 
 /// Options for the histogram figure.
 struct HistogramPlotOptions {

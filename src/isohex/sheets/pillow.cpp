@@ -5,6 +5,7 @@
 #include "isohex/mesh/topology.hpp"
 #include "isohex/mesh/validate.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 #include "isohex/sheets/pillow_split.hpp"
 
 #include <fmt/format.h>
@@ -159,13 +160,14 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
     if (out.has_blocks()) out.blocks.push_back(mesh.blocks[iq[q].shrink_hex]);
   }
 
-  // Halve the displacements of vertices used by inverted new or changed hexes until none
-  // is. New hexes at a folded vertex (where no placement can make them positive) are left to
-  // an untangler rather than collapsing their neighbours' layer.
+  // Halve the displacements of vertices used by new or changed hexes that are not valid
+  // inside (certified: a fold between Verdict's samples counts) until none is. New hexes at
+  // a folded vertex (where no placement can make them positive) are left to an untangler
+  // rather than collapsing their neighbours' layer.
   std::vector<Index> checked = changed;
   std::vector<char> was_positive(changed.size(), 1);
   for (std::size_t i = 0; i < changed.size(); ++i)
-    was_positive[i] = positive(scaled_jacobian(mesh.corners(changed[i])));
+    was_positive[i] = positive(certified_scaled_jacobian(mesh.corners(changed[i])));
   for (std::size_t q = 0; q < iq.size(); ++q)
     if (std::none_of(iq[q].v.begin(), iq[q].v.end(), [&](Index v) { return split.folded[v] != 0; })) {
       checked.push_back(nh0 + static_cast<Index>(q));
@@ -176,7 +178,7 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
     std::vector<char> halve(copies.size(), 0);
     bool any = false;
     for (std::size_t i = 0; i < checked.size(); ++i) {
-      if (!was_positive[i] || positive(scaled_jacobian(out.corners(checked[i])))) continue;
+      if (!was_positive[i] || positive(certified_scaled_jacobian(out.corners(checked[i])))) continue;
       any = true;
       for (Index x : out.hexes[checked[i]])
         if (x >= nv0) halve[x - nv0] = 1;
@@ -197,7 +199,7 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
     r.inverted_new_hexes += !positive(sj);
   }
   for (std::size_t i = 0; i < changed.size(); ++i)
-    r.inverted_changed_hexes += was_positive[i] && !positive(scaled_jacobian(out.corners(changed[i])));
+    r.inverted_changed_hexes += was_positive[i] && !positive(certified_scaled_jacobian(out.corners(changed[i])));
   return r;
 }
 

@@ -79,7 +79,8 @@ struct SurfaceSmoothingOptions {
   double convergence = 1e-4;          ///< stop once no vertex moved more than this × the mean boundary edge length
   /// Check the hexes as well as the boundary quads. Off when a boundary pillow follows: the
   /// pillow gives every boundary quad a new hex and the hexes below are re-shaped anyway,
-  /// so only the surface's own quality matters, and the hexes' floors would block it.
+  /// so only the surface's own quality matters, and the hexes' floors would block it. Interior
+  /// moves check their hexes all the same (vertex_moves.hpp).
   bool guard_hexes = true;
   /// Passes of local max–min moves after the relaxation (0 = none): each boundary vertex of a
   /// quad below `worst_target` searches its tangent plane for the point on the isosurface that

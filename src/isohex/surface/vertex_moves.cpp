@@ -1,6 +1,7 @@
 #include "isohex/surface/vertex_moves.hpp"
 
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +19,7 @@ double hex_sj(const HexMesh& mesh, Index h, Index v, const Vec3& y) {
     const Index w = mesh.hexes[h][i];
     c[i] = w == v ? y : mesh.points[w];
   }
-  return sj_or_zero(scaled_jacobian(c));
+  return sj_or_zero(certified_scaled_jacobian(c));
 }
 
 double quad_sj(const HexMesh& mesh, const Quad& q, Index v, const Vec3& y) {
@@ -63,7 +64,19 @@ Vec3 outward_normal(const MoveContext& ctx, Index v) {
   return quads_normal(ctx, v);
 }
 
-bool constrain(const MoveContext& ctx, Index v, Vec3& y, double reach) {
+namespace {
+
+// Within the sampled volume: the isosurface goes on past its faces (the field is extended
+// there), and boundary smoothing without the hex guard carried vertices 123 mm out of cthead
+// along it.
+bool in_volume(const MoveContext& ctx, const Vec3& y) {
+  const Volume& vol = ctx.field.volume();
+  const Vec3 lo = vol.origin, hi = vol.max_corner();
+  const double slack = 1e-9 * (hi - lo).norm();
+  return !((y.array() < lo.array() - slack).any() || (y.array() > hi.array() + slack).any());
+}
+
+bool constrain_to_surface(const MoveContext& ctx, Index v, Vec3& y, double reach) {
   const int a = plane_axis(ctx, v);
   if (a < 0) return ctx.field.project(y, reach, ctx.level_tolerance) && y.allFinite();
   y[a] = ctx.mesh.points[v][a];
@@ -88,6 +101,12 @@ bool constrain(const MoveContext& ctx, Index v, Vec3& y, double reach) {
     y = z;
   }
   return false;
+}
+
+}  // namespace
+
+bool constrain(const MoveContext& ctx, Index v, Vec3& y, double reach) {
+  return constrain_to_surface(ctx, v, y, reach) && in_volume(ctx, y);
 }
 
 Vec3 quad_umbrella(const MoveContext& ctx, Index v) {
@@ -163,7 +182,10 @@ bool move_is_acceptable(const MoveContext& ctx, Index v, const Vec3& y, bool bou
   const bool relax = check == Check::relax;
   const double hex_soft = relax ? ctx.hex_floor : 0.0;
   const auto& vh = ctx.graph.vertex_hexes;
-  for (Index k = ctx.guard_hexes ? vh.offsets[v] : vh.offsets[v + 1]; k < vh.offsets[v + 1]; ++k) {
+  // Interior moves keep their hexes even when a pillow follows (guard_hexes off): unguarded,
+  // the pull of a large hex's mass centre fed on itself and carried vertices 123 mm out of
+  // cthead's volume at h 3.
+  for (Index k = ctx.guard_hexes || !boundary ? vh.offsets[v] : vh.offsets[v + 1]; k < vh.offsets[v + 1]; ++k) {
     const Index h = vh.ids[k];
     const double after = hex_sj(mesh, h, v, y);
     if (after >= hex_soft) continue;  // the common case: no need for the old value

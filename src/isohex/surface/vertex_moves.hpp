@@ -36,7 +36,7 @@ struct MoveContext {
   int max_halvings;
   double level_tolerance;  ///< absolute |L| a projection aims for
   double projection_reach; ///< × the mean boundary edge length at the vertex
-  bool guard_hexes = true;  ///< false: only the boundary quads are checked (a pillow follows)
+  bool guard_hexes = true;  ///< false: boundary moves check only the boundary quads (a pillow follows); interior moves always check their hexes
   /// Per vertex (or empty): −1; an axis a (0–2): the vertex slides in the plane x_a = const
   /// through it (a domain-box face) instead of on the isosurface; a + 3: it slides along the
   /// rim where that plane meets the isosurface.

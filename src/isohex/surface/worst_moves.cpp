@@ -2,6 +2,7 @@
 // that unfolds boundary quads, which a Laplacian relaxation alone leaves folded.
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 #include "isohex/surface/vertex_moves.hpp"
 
 #include <tbb/parallel_for.h>
@@ -125,9 +126,9 @@ bool hexes_allow(const MoveContext& ctx, Index v, const Vec3& y) {
     std::array<Vec3, 8> c = ctx.mesh.corners(h);
     for (int i = 0; i < 8; ++i)
       if (ctx.mesh.hexes[h][i] == v) c[i] = y;
-    const double after = sj_or_zero(scaled_jacobian(c));
+    const double after = sj_or_zero(certified_scaled_jacobian(c));
     if (after >= ctx.hex_floor) continue;
-    if (!keeps_floors(sj_or_zero(scaled_jacobian(ctx.mesh.corners(h))), after, ctx.hex_floor, 0.0)) return false;
+    if (!keeps_floors(sj_or_zero(certified_scaled_jacobian(ctx.mesh.corners(h))), after, ctx.hex_floor, 0.0)) return false;
   }
   return true;
 }

@@ -1,0 +1,314 @@
+// Bernstein bounds of the trilinear hex's Jacobian determinant, adaptive subdivision, and
+// the whole-mesh evaluations built on them.
+#include "isohex/quality/jacobian_bounds.hpp"
+
+#include "isohex/mesh/topology.hpp"
+#include "isohex/quality/hex_quality.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+namespace isohex {
+
+namespace {
+
+// Corners relative to corner 0: det J is translation invariant, and differences keep the
+// digits of elements far from the origin.
+std::array<Vec3, 8> relative(const std::array<Vec3, 8>& p) {
+  std::array<Vec3, 8> q;
+  for (int k = 0; k < 8; ++k) q[k] = p[k] - p[0];
+  return q;
+}
+
+double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
+  const double u0 = 1 - u, v0 = 1 - v, w0 = 1 - w;
+  const Vec3 xu = v0 * w0 * (p[1] - p[0]) + v * w0 * (p[2] - p[3]) + v0 * w * (p[5] - p[4]) + v * w * (p[6] - p[7]);
+  const Vec3 xv = u0 * w0 * (p[3] - p[0]) + u * w0 * (p[2] - p[1]) + u0 * w * (p[7] - p[4]) + u * w * (p[6] - p[5]);
+  const Vec3 xw = u0 * v0 * (p[4] - p[0]) + u * v0 * (p[5] - p[1]) + u * v * (p[6] - p[2]) + u0 * v * (p[7] - p[3]);
+  return xu.dot(xv.cross(xw));
+}
+
+// Bernstein coefficients of a quadratic from its values at 0, 1/2, 1 of the interval.
+inline void to_bernstein(double& f0, double& f1, double& f2) { f1 = 2 * f1 - 0.5 * (f0 + f2); }
+
+// The 27 samples on the lattice of [lo, hi] and their Bernstein coefficients; `samples`
+// (values actually taken by det J) may be null.
+std::array<double, 27> bernstein_box(const std::array<Vec3, 8>& q, const Vec3& lo, const Vec3& hi,
+                                     std::array<double, 27>* samples) {
+  std::array<double, 27> b;
+  const Vec3 mid = 0.5 * (lo + hi);
+  const double us[3] = {lo[0], mid[0], hi[0]}, vs[3] = {lo[1], mid[1], hi[1]}, ws[3] = {lo[2], mid[2], hi[2]};
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) b[i + 3 * j + 9 * k] = det_at(q, us[i], vs[j], ws[k]);
+  if (samples) *samples = b;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) to_bernstein(b[3 * j + 9 * k], b[1 + 3 * j + 9 * k], b[2 + 3 * j + 9 * k]);
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 3; ++i) to_bernstein(b[i + 9 * k], b[i + 3 + 9 * k], b[i + 6 + 9 * k]);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) to_bernstein(b[i + 3 * j], b[i + 3 * j + 9], b[i + 3 * j + 18]);
+  return b;
+}
+
+struct Box {
+  Vec3 lo, hi;
+  double min_coef, max_coef;
+};
+
+// Adaptive subdivision: two heaps over the leaves (by smallest and by largest coefficient),
+// with lazy deletion of split leaves. Deterministic: ties are broken by leaf number.
+class Subdivision {
+ public:
+  Subdivision(const std::array<Vec3, 8>& p) : q_(relative(p)) { add(Vec3::Zero(), Vec3::Ones()); }
+
+  JacobianBounds run(const JacobianBoundOptions& o) {
+    JacobianBounds r;
+    for (;;) {
+      r.min_lower = boxes_[low_.top().second].min_coef;
+      r.max_upper = boxes_[high_.top().second].max_coef;
+      r.min_upper = min_sample_;
+      r.max_lower = max_sample_;
+      if (o.sign_only && (r.min_lower > 0 || r.min_upper <= 0)) break;
+      const double scale = std::max(std::abs(min_sample_), std::abs(max_sample_));
+      const double gap_min = r.min_upper - r.min_lower, gap_max = r.max_upper - r.max_lower;
+      // Within tolerance, but never with the sign still open: a valid hex whose minimum is a
+      // tiny fraction of its maximum must still be certified (as Gmsh does).
+      const bool decided = r.min_lower > 0 || r.min_upper <= 0;
+      if (!o.sign_only && decided && gap_min <= o.tolerance * scale && gap_max <= o.tolerance * scale) break;
+      if (r.subdivisions >= o.max_subdivisions || !(scale > 0)) break;
+      const bool for_min = o.sign_only || !decided || gap_min >= gap_max;
+      std::size_t leaf;
+      if (for_min) {
+        leaf = low_.top().second;
+        low_.pop();
+      } else {
+        leaf = high_.top().second;
+        high_.pop();
+      }
+      split(leaf);
+      ++r.subdivisions;
+    }
+    return r;
+  }
+
+ private:
+  void add(const Vec3& lo, const Vec3& hi) {
+    std::array<double, 27> s;
+    const std::array<double, 27> b = bernstein_box(q_, lo, hi, &s);
+    Box box{lo, hi, b[0], b[0]};
+    for (double c : b) {
+      box.min_coef = std::min(box.min_coef, c);
+      box.max_coef = std::max(box.max_coef, c);
+    }
+    for (double x : s) {
+      min_sample_ = std::min(min_sample_, x);
+      max_sample_ = std::max(max_sample_, x);
+    }
+    const std::size_t id = boxes_.size();
+    boxes_.push_back(box);
+    alive_.push_back(1);
+    low_.push({box.min_coef, id});
+    high_.push({-box.max_coef, id});
+  }
+
+  void split(std::size_t leaf) {
+    alive_[leaf] = 0;
+    const Box b = boxes_[leaf];
+    const Vec3 mid = 0.5 * (b.lo + b.hi);
+    for (int c = 0; c < 8; ++c) {
+      Vec3 lo, hi;
+      for (int a = 0; a < 3; ++a) {
+        const bool upper = (c >> a) & 1;
+        lo[a] = upper ? mid[a] : b.lo[a];
+        hi[a] = upper ? b.hi[a] : mid[a];
+      }
+      add(lo, hi);
+    }
+    drop_dead();
+  }
+
+  // Leaves split through the other heap are dropped when they surface.
+  void drop_dead() {
+    while (!alive_[low_.top().second]) low_.pop();
+    while (!alive_[high_.top().second]) high_.pop();
+  }
+
+  using Entry = std::pair<double, std::size_t>;
+  using MinHeap = std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>>;
+  std::array<Vec3, 8> q_;
+  std::vector<Box> boxes_;
+  std::vector<std::uint8_t> alive_;
+  MinHeap low_, high_;  // high_ holds −max so that its top is the largest coefficient
+  double min_sample_ = std::numeric_limits<double>::infinity();
+  double max_sample_ = -std::numeric_limits<double>::infinity();
+};
+
+// Gauss–Legendre nodes and weights on [0, 1].
+constexpr double kG2 = 0.21132486540518711775;  // (1 − 1/√3)/2
+constexpr std::array<double, 4> kG4x = {0.069431844202973712, 0.33000947820757187, 0.66999052179242813,
+                                        0.93056815579702629};
+constexpr std::array<double, 4> kG4w = {0.17392742256872693, 0.32607257743127307, 0.32607257743127307,
+                                        0.17392742256872693};
+
+// ∫ |det J| over the element: exact (the signed volume) when it is certified valid, else
+// Gauss 4×4×4 on each of 4×4×4 sub-boxes (|det J| is not a polynomial where it changes sign).
+double abs_volume(const std::array<Vec3, 8>& p) {
+  if (certified_valid(p)) return volume(p);
+  const std::array<Vec3, 8> q = relative(p);
+  constexpr int n = 4;
+  double sum = 0;
+  for (int c = 0; c < n * n * n; ++c) {
+    const int a = c % n, b = (c / n) % n, d = c / (n * n);
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        for (int k = 0; k < 4; ++k)
+          sum += kG4w[i] * kG4w[j] * kG4w[k] *
+                 std::abs(det_at(q, (a + kG4x[i]) / n, (b + kG4x[j]) / n, (d + kG4x[k]) / n));
+  }
+  return sum / (n * n * n);
+}
+
+// min / max clamped to [-1, 1]; an element negative everywhere is -1, a flat one 0.
+double ratio_of(const JacobianBounds& b) {
+  if (!(b.max_upper > 0)) return b.max_upper == 0 && b.min_lower == 0 ? 0.0 : -1.0;
+  return std::max(-1.0, std::min(1.0, b.min_lower / b.max_upper));
+}
+
+}  // namespace
+
+double jacobian_determinant(const std::array<Vec3, 8>& p, double u, double v, double w) {
+  return det_at(relative(p), u, v, w);
+}
+
+std::array<double, 27> jacobian_bernstein(const std::array<Vec3, 8>& p, const Vec3& lo, const Vec3& hi) {
+  return bernstein_box(relative(p), lo, hi, nullptr);
+}
+
+JacobianBounds jacobian_bounds(const std::array<Vec3, 8>& p, const JacobianBoundOptions& options) {
+  for (const Vec3& x : p)
+    if (!x.allFinite()) {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      return {nan, nan, nan, nan, 0};  // neither valid() nor invalid(): undecidable
+    }
+  return Subdivision(p).run(options);
+}
+
+double jacobian_ratio(const std::array<Vec3, 8>& p) { return ratio_of(jacobian_bounds(p)); }
+
+double gauss_min_jacobian(const std::array<Vec3, 8>& p) {
+  const std::array<Vec3, 8> q = relative(p);
+  double m = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 8; ++c)
+    m = std::min(m, det_at(q, c & 1 ? 1 - kG2 : kG2, c & 2 ? 1 - kG2 : kG2, c & 4 ? 1 - kG2 : kG2));
+  return m;
+}
+
+bool certified_valid(const std::array<Vec3, 8>& p, double floor, int max_subdivisions) {
+  const std::array<Vec3, 8> q = relative(p);
+  // Depth-first on the boxes whose coefficients are not all above the floor; any sample at or
+  // below it decides "not certified" at once.
+  std::array<double, 27> s;
+  std::vector<std::pair<Vec3, Vec3>> stack{{Vec3::Zero(), Vec3::Ones()}};
+  int splits = 0;
+  while (!stack.empty()) {
+    const auto [lo, hi] = stack.back();
+    stack.pop_back();
+    const std::array<double, 27> b = bernstein_box(q, lo, hi, &s);
+    if (!(*std::min_element(s.begin(), s.end()) > floor)) return false;
+    if (*std::min_element(b.begin(), b.end()) > floor) continue;
+    if (++splits > max_subdivisions) return false;
+    const Vec3 mid = 0.5 * (lo + hi);
+    for (int c = 0; c < 8; ++c) {
+      Vec3 l, h;
+      for (int a = 0; a < 3; ++a) {
+        const bool upper = (c >> a) & 1;
+        l[a] = upper ? mid[a] : lo[a];
+        h[a] = upper ? hi[a] : mid[a];
+      }
+      stack.push_back({l, h});
+    }
+  }
+  return true;
+}
+
+double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
+  const double sj = scaled_jacobian(p);
+  if (is_degenerate(sj) || !(sj > 0)) return sj;
+  return certified_valid(p) ? sj : 0.0;
+}
+
+double jacobian_ratio_bound(const std::array<Vec3, 8>& p) {
+  const std::array<double, 27> b = jacobian_bernstein(p);
+  const auto [lo, hi] = std::minmax_element(b.begin(), b.end());
+  if (!(*hi > 0)) return *hi == 0 && *lo == 0 ? 0.0 : -1.0;
+  return std::max(-1.0, *lo / *hi);
+}
+
+std::vector<double> certified_scaled_jacobians(const HexMesh& mesh) {
+  std::vector<double> sj = scaled_jacobians(mesh);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj.size(), 1024), [&](const auto& range) {
+    for (std::size_t h = range.begin(); h != range.end(); ++h)
+      if (sj[h] > 0 && !is_degenerate(sj[h]) && !certified_valid(mesh.corners(static_cast<Index>(h)))) sj[h] = 0.0;
+  });
+  return sj;
+}
+
+MeshJacobians mesh_jacobians(const HexMesh& mesh) {
+  const std::size_t n = mesh.hexes.size();
+  MeshJacobians r{std::vector<double>(n), std::vector<double>(n), std::vector<std::uint8_t>(n)};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& range) {
+    for (std::size_t h = range.begin(); h != range.end(); ++h) {
+      const auto p = mesh.corners(static_cast<Index>(h));
+      const JacobianBounds b = jacobian_bounds(p);
+      r.ratio[h] = ratio_of(b);
+      r.valid[h] = b.valid() ? 1 : 0;
+      r.gauss_min[h] = gauss_min_jacobian(p);
+    }
+  });
+  return r;
+}
+
+std::vector<double> jacobian_ratios(const HexMesh& mesh) {
+  std::vector<double> r(mesh.hexes.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.size(), 256), [&](const auto& range) {
+    for (std::size_t h = range.begin(); h != range.end(); ++h) r[h] = jacobian_ratio(mesh.corners(static_cast<Index>(h)));
+  });
+  return r;
+}
+
+VolumeBalance volume_balance(const HexMesh& mesh) {
+  VolumeBalance r;
+  const std::size_t n = mesh.hexes.size();
+  std::vector<double> abs_v(n), signed_v(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& range) {
+    for (std::size_t h = range.begin(); h != range.end(); ++h) {
+      const auto p = mesh.corners(static_cast<Index>(h));
+      signed_v[h] = volume(p);
+      abs_v[h] = abs_volume(p);
+    }
+  });
+  for (std::size_t h = 0; h < n; ++h) {  // in hex order: the same bits for any thread count
+    r.hexes += abs_v[h];
+    r.signed_hexes += signed_v[h];
+  }
+  // (1/3) ∮ x·n dA over the bilinear boundary patches, about the first vertex for precision:
+  // the integrand has degree 2 in each parameter, so 2×2 Gauss points are exact.
+  const Vec3 o = mesh.points.empty() ? Vec3::Zero() : mesh.points[0];
+  for (const Quad& q : boundary_quads(mesh)) {
+    const Vec3 a = mesh.points[q[0]] - o, b = mesh.points[q[1]] - o, c = mesh.points[q[2]] - o, d = mesh.points[q[3]] - o;
+    for (int i = 0; i < 4; ++i) {
+      const double s = i & 1 ? 1 - kG2 : kG2, t = i & 2 ? 1 - kG2 : kG2;
+      const Vec3 x = (1 - s) * (1 - t) * a + s * (1 - t) * b + s * t * c + (1 - s) * t * d;
+      const Vec3 xs = (1 - t) * (b - a) + t * (c - d), xt = (1 - s) * (d - a) + s * (c - b);
+      r.enclosed += 0.25 * x.dot(xs.cross(xt)) / 3;
+    }
+  }
+  return r;
+}
+
+}  // namespace isohex

@@ -1,0 +1,198 @@
+// Certified validity inside the element: Bernstein bounds of det J against dense sampling,
+// the bow tie that Verdict's nine samples pass, the ratio and Gauss-point measures, and the
+// volume balance of whole meshes.
+#include "isohex/mesh/generate.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+using namespace isohex;
+
+namespace {
+
+using Corners = std::array<Vec3, 8>;
+
+using isohex::test::unit_cube;
+
+// Corners 3 and 7 thrown across the element (found by a random search): every corner frame
+// and the centre frame are positive (scaled Jacobian 0.04), yet det J < 0 at Gauss points.
+Corners bow_tie() {
+  Corners p = unit_cube();
+  p[3] = Vec3(0.31, 0.177, 0.416);
+  p[7] = Vec3(0.945, 0.808, -0.639);
+  return p;
+}
+
+// Dense sampling: min and max of det J on an n^3 lattice of the parameter cube.
+std::pair<double, double> sampled(const Corners& p, int n) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) {
+        const double d = jacobian_determinant(p, i / (n - 1.0), j / (n - 1.0), k / (n - 1.0));
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+      }
+  return {lo, hi};
+}
+
+// The quadratic Bernstein basis on [0, 1].
+double b2(int i, double t) { return i == 0 ? (1 - t) * (1 - t) : i == 1 ? 2 * t * (1 - t) : t * t; }
+
+Corners jittered(std::mt19937_64& rng, double amount) {
+  std::normal_distribution<double> g(0, amount);
+  Corners p = unit_cube();
+  for (Vec3& x : p) x += Vec3(g(rng), g(rng), g(rng));
+  return p;
+}
+
+}  // namespace
+
+TEST(JacobianBounds, CoefficientsReproduceTheDeterminant) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> t(0, 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Corners p = jittered(rng, 0.3);
+    const Vec3 lo(0.25 * t(rng), 0.25 * t(rng), 0.25 * t(rng)), hi(0.5 + 0.5 * t(rng), 0.5 + 0.5 * t(rng), 1);
+    const auto b = jacobian_bernstein(p, lo, hi);
+    for (int s = 0; s < 20; ++s) {
+      const double u = t(rng), v = t(rng), w = t(rng);
+      double sum = 0;
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < 3; ++j)
+          for (int i = 0; i < 3; ++i) sum += b[i + 3 * j + 9 * k] * b2(i, u) * b2(j, v) * b2(k, w);
+      const double direct = jacobian_determinant(p, lo[0] + u * (hi[0] - lo[0]), lo[1] + v * (hi[1] - lo[1]),
+                                                 lo[2] + w * (hi[2] - lo[2]));
+      EXPECT_NEAR(sum, direct, 1e-12);
+    }
+  }
+}
+
+TEST(JacobianBounds, CornerCoefficientsAreTheCornerJacobians) {
+  std::mt19937_64 rng(7);
+  const Corners p = jittered(rng, 0.2);
+  const auto b = jacobian_bernstein(p);
+  for (int k = 0; k < 8; ++k) {
+    const auto& nb = kCornerNeighbors[k];
+    Eigen::Matrix3d A;
+    for (int j = 0; j < 3; ++j) A.col(j) = p[nb[j]] - p[k];
+    const int i = (k == 1 || k == 2 || k == 5 || k == 6) ? 2 : 0, j = (k == 2 || k == 3 || k == 6 || k == 7) ? 2 : 0,
+              l = k >= 4 ? 2 : 0;
+    EXPECT_NEAR(b[i + 3 * j + 9 * l], A.determinant(), 1e-13) << "corner " << k;
+  }
+}
+
+TEST(JacobianBounds, ParallelepipedIsExact) {
+  Corners p = unit_cube();
+  Eigen::Matrix3d M;
+  M << 2, 0.5, 0.1, 0, 1, 0.3, 0, 0, 3;
+  for (Vec3& x : p) x = M * x + Vec3(100, -50, 7);
+  const JacobianBounds b = jacobian_bounds(p);
+  EXPECT_NEAR(b.min_lower, M.determinant(), 1e-9);
+  EXPECT_NEAR(b.max_upper, M.determinant(), 1e-9);
+  EXPECT_EQ(b.subdivisions, 0);
+  EXPECT_NEAR(jacobian_ratio(p), 1.0, 1e-12);
+  EXPECT_TRUE(certified_valid(p));
+}
+
+TEST(JacobianBounds, BoundsEncloseDenseSamplingOnRandomHexes) {
+  std::mt19937_64 rng(11);
+  int certified = 0, invalid = 0, undecided = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Corners p = jittered(rng, trial < 200 ? 0.15 : 0.35);
+    const JacobianBounds b = jacobian_bounds(p);
+    const auto [lo, hi] = sampled(p, 13);
+    const double tol = 1e-12 * std::max(std::abs(lo), std::abs(hi));
+    EXPECT_LE(b.min_lower, lo + tol);
+    EXPECT_GE(b.max_upper, hi - tol);
+    EXPECT_LE(b.min_lower, b.min_upper);
+    EXPECT_LE(b.max_lower, b.max_upper);
+    // The attained values are values of det J: no lower than the true minimum, which the
+    // dense sampling overestimates by at most the refinement tolerance here.
+    EXPECT_LE(b.min_upper, lo + 1e-3 * std::max(std::abs(lo), std::abs(hi)) + tol);
+    if (b.valid()) {
+      ++certified;
+      EXPECT_GT(lo, 0) << "certified hex " << trial << " has a non-positive sample";
+      EXPECT_TRUE(certified_valid(p, 0, 512));
+    } else if (b.invalid()) {
+      ++invalid;
+      EXPECT_FALSE(certified_valid(p));
+    } else {
+      ++undecided;
+    }
+    EXPECT_EQ(b.valid(), jacobian_ratio(p) > 0);
+    // The cheap test is sufficient: it never certifies what the full bounds do not.
+    if (certified_valid(p)) EXPECT_TRUE(b.valid());
+  }
+  EXPECT_GT(certified, 100);
+  EXPECT_GT(invalid, 20);
+  EXPECT_EQ(undecided, 0);
+}
+
+TEST(JacobianBounds, BowTiePassesVerdictButIsNotValidInside) {
+  const Corners p = bow_tie();
+  EXPECT_GT(scaled_jacobian(p), 0);  // all nine of Verdict's samples are positive
+  EXPECT_LT(gauss_min_jacobian(p), 0);
+  const JacobianBounds b = jacobian_bounds(p);
+  EXPECT_TRUE(b.invalid());
+  EXPECT_FALSE(b.valid());
+  EXPECT_FALSE(certified_valid(p, 0, 4096));
+  EXPECT_LT(jacobian_ratio(p), 0);
+  EXPECT_LT(sampled(p, 21).first, 0);
+}
+
+TEST(JacobianBounds, GaussPointsOfACube) {
+  Corners p = unit_cube();
+  for (Vec3& x : p) x *= 2;
+  EXPECT_NEAR(gauss_min_jacobian(p), 8.0, 1e-12);
+  EXPECT_NEAR(hex_metric(HexMetric::gauss_jacobian, p), 8.0, 1e-12);
+  EXPECT_NEAR(hex_metric(HexMetric::jacobian_ratio, p), 1.0, 1e-12);
+}
+
+TEST(JacobianBounds, FlatAndCollapsedElements) {
+  Corners flat = unit_cube();
+  for (int k = 4; k < 8; ++k) flat[k][2] = 0;
+  EXPECT_FALSE(jacobian_bounds(flat).valid());
+  EXPECT_EQ(jacobian_ratio(flat), 0.0);
+  EXPECT_FALSE(certified_valid(flat));
+  Corners nan = unit_cube();
+  nan[6][0] = std::nan("");
+  EXPECT_FALSE(jacobian_bounds(nan).valid());
+  EXPECT_FALSE(certified_valid(nan));
+}
+
+TEST(JacobianBounds, FloorIsRespected) {
+  Corners p = unit_cube();
+  EXPECT_TRUE(certified_valid(p, 0.99));
+  EXPECT_FALSE(certified_valid(p, 1.0));
+}
+
+TEST(VolumeBalance, BoxMatchesAndAFoldIsSeen) {
+  HexMesh box = box_mesh(4, 3, 2, Vec3::Zero(), Vec3(2, 3, 1));
+  VolumeBalance v = volume_balance(box);
+  EXPECT_NEAR(v.enclosed, 6.0, 1e-12);
+  EXPECT_NEAR(v.hexes, 6.0, 1e-12);
+  EXPECT_NEAR(v.signed_hexes, 6.0, 1e-12);
+  // Push an interior vertex across its neighbours: signed volumes still add up to the
+  // enclosed volume, |det J| does not.
+  HexMesh folded = box_mesh(4, 4, 4);
+  const MeshJacobians before = mesh_jacobians(folded);
+  EXPECT_TRUE(std::all_of(before.valid.begin(), before.valid.end(), [](auto x) { return x == 1; }));
+  Index centre = -1;
+  for (Index i = 0; i < folded.num_vertices(); ++i)
+    if ((folded.points[i] - Vec3(0.5, 0.5, 0.5)).norm() < 1e-12) centre = i;
+  ASSERT_GE(centre, 0);
+  folded.points[centre] += Vec3(0.4, 0.05, 0.02);
+  v = volume_balance(folded);
+  EXPECT_NEAR(v.signed_hexes, 1.0, 1e-12);
+  EXPECT_NEAR(v.enclosed, 1.0, 1e-12);
+  EXPECT_GT(v.excess(), 1e-3);
+  const MeshJacobians after = mesh_jacobians(folded);
+  EXPECT_GT(std::count(after.valid.begin(), after.valid.end(), 0), 0);
+}
