@@ -25,23 +25,16 @@ other end, *NODE PRINT of U); ccx must print "Job finished" and no *ERROR or *WA
 
 Exits 77 (ctest: skipped) without ccx; the pipeline cases skip without the shared data.
 """
-import argparse
 import os
 import re
 import shutil
 import subprocess
 import sys
 
-FAILURES = []
+from oracle_support import check, finish, oracle_args
+
 
 E, NU = 1000.0, 0.3  # any consistent units
-
-
-def check(ok, what):
-    if not ok:
-        FAILURES.append(what)
-        print("FAIL:", what)
-    return ok
 
 
 def run(cmd, cwd=None, timeout=600):
@@ -285,18 +278,12 @@ def test_pipeline(cli, ccx, data, tmp):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--cli", required=True)
-    ap.add_argument("--data", required=True)
-    ap.add_argument("--tmp", required=True)
-    ap.add_argument("--no-pipeline", action="store_true", help="the beam only (or ISOHEX_CCX_PIPELINE=0)")
-    args = ap.parse_args()
+    args = oracle_args(__doc__.split("\n")[0], lambda ap: ap.add_argument(
+        "--no-pipeline", action="store_true", help="the beam only (or ISOHEX_CCX_PIPELINE=0)"))
     ccx = shutil.which("ccx")
     if ccx is None:
         print("SKIP: ccx is not installed (scripts/install-deps.sh installs calculix-ccx)")
         return 77
-    shutil.rmtree(args.tmp, ignore_errors=True)
-    os.makedirs(args.tmp)
     test_beam(args.cli, ccx, args.tmp)
     if not args.no_pipeline and os.environ.get("ISOHEX_CCX_PIPELINE") != "0":
         if os.path.isdir(os.path.join(args.data, "volumes")):
@@ -305,11 +292,7 @@ def main():
             print("SKIP (pipeline meshes only): no shared data")
     else:
         print("pipeline meshes not run (--no-pipeline or ISOHEX_CCX_PIPELINE=0)")
-    if FAILURES:
-        print(f"{len(FAILURES)} failures")
-        return 1
-    print("all checks passed")
-    return 0
+    return finish()
 
 
 if __name__ == "__main__":

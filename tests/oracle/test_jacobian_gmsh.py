@@ -61,7 +61,6 @@ exit 1 and name hex 1 for a mesh whose hex 1 is the bow tie, exit 1 with the sam
 the per-element ratios on a jittered box, and exit 0 on a clean box. Exits non-zero on any
 failure; without gmsh only the checks that do not need it run.
 """
-import argparse
 import json
 import os
 import re
@@ -74,17 +73,11 @@ import numpy as np
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk
 
-FAILURES = []
+from oracle_support import check, finish, oracle_args
+
 BAND = 0.0    # |Gmsh minJ/maxJ| below which isohex may leave a valid element not certified (none: both refine until the sign is decided)
 RTOL = 2e-3   # |isohex ratio - Gmsh ratio|, from the two 1e-3 tolerances (see above)
 TOTAL = {"compared": 0, "agree": 0, "band": 0, "inverted": 0, "invalid": 0, "maxdiff": 0.0}
-
-
-def check(ok, what):
-    if not ok:
-        FAILURES.append(what)
-        print("FAIL:", what)
-    return ok
 
 
 def run(cmd, timeout=300):
@@ -483,13 +476,7 @@ def check_command(cli, msh, tmp, want_rc, want_hexes, name):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--cli", required=True)
-    ap.add_argument("--data", required=True)
-    ap.add_argument("--tmp", required=True)
-    a = ap.parse_args()
-    shutil.rmtree(a.tmp, ignore_errors=True)
-    os.makedirs(a.tmp)
+    a = oracle_args(__doc__)
     gmsh = shutil.which("gmsh")
     if gmsh is None:
         print("SKIP (Gmsh comparisons only): the gmsh command is not installed (scripts/install-deps.sh installs it)")
@@ -571,11 +558,7 @@ def main():
         print(f"summary: {t['compared']} hexes compared with Gmsh, {t['agree']} with the same verdict, "
               f"{t['band']} within {BAND} of 0 (isohex not certified, Gmsh valid), {t['invalid']} not valid inside "
               f"({t['inverted']} negative everywhere), max |ratio difference| {t['maxdiff']:.3g} (tolerance {RTOL})")
-    if FAILURES:
-        print(f"{len(FAILURES)} failures")
-        return 1
-    print("all checks passed")
-    return 0
+    return finish()
 
 
 if __name__ == "__main__":
