@@ -36,7 +36,6 @@ struct Inside {
   VolumeBalance volume;
   std::size_t short_edges = 0;
   double median_edge = 0, shortest_edge = 0;
-  std::vector<Index> short_edge_hexes;  // a hex of each of the first short edges
 };
 
 Inside check_inside(const HexMesh& mesh, const Args& a) {

@@ -240,8 +240,7 @@ void run(const Args& a) {
   std::size_t outside_domain = 0;
   {
     const double slack = 1e-9 * (region.domain.hi - region.domain.lo).norm();
-    for (const Vec3& x : out.mesh.points)
-      outside_domain += ((x.array() < region.domain.lo.array() - slack) || (x.array() > region.domain.hi.array() + slack)).any();
+    for (const Vec3& x : out.mesh.points) outside_domain += !region.domain.contains(x, slack);
   }
   const double check_time = seconds_since(t);
   t = Clock::now();

@@ -146,7 +146,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
     // Hexes that need the release: below 0.2 by the certified scaled Jacobian, or valid inside
     // with a jacobian ratio below 0.1 (a fold about to open: the worst pass ranks them alike).
     std::vector<double> sj = certified_scaled_jacobians(mesh);
-    const std::vector<double> ratio = jacobian_ratios(mesh);
+    const std::vector<double> ratio = hex_metric(mesh, HexMetric::jacobian_ratio);
     for (std::size_t h = 0; h < sj.size(); ++h)
       if (!is_degenerate(sj[h])) sj[h] = std::min(sj[h], 2 * ratio[h]);
     std::vector<Index> candidates;

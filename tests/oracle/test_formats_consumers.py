@@ -23,7 +23,6 @@ written by VTK as .vtu and converted by `isohex convert` into every output forma
 The boundary reference comes from VTK's own hexahedron faces (vtkCell.GetFace), not from
 isohex. Exits non-zero on any failure.
 """
-import argparse
 import os
 import re
 import shutil
@@ -35,14 +34,7 @@ import vtk
 from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtk_support import read_vtu
 
-FAILURES = []
-
-
-def check(ok, what):
-    if not ok:
-        FAILURES.append(what)
-        print("FAIL:", what)
-    return ok
+from oracle_support import check, finish, oracle_args
 
 
 def run(cmd):
@@ -521,13 +513,7 @@ def test_errors(cli, tmp):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--cli", required=True)
-    ap.add_argument("--data", required=True)
-    ap.add_argument("--tmp", required=True)
-    args = ap.parse_args()
-    shutil.rmtree(args.tmp, ignore_errors=True)
-    os.makedirs(args.tmp)
+    args = oracle_args(__doc__)
     gmsh = shutil.which("gmsh")
     if gmsh is None:
         print("SKIP (gmsh checks only): the gmsh command is not installed (scripts/install-deps.sh installs it)")
@@ -542,11 +528,7 @@ def main():
     if gmsh:
         check_gmsh_mirrored(gmsh, args.cli, args.tmp)
     test_errors(args.cli, args.tmp)
-    if FAILURES:
-        print(f"{len(FAILURES)} failures")
-        return 1
-    print("all checks passed")
-    return 0
+    return finish()
 
 
 if __name__ == "__main__":

@@ -63,6 +63,28 @@ Vec3 IsoField::root_on_segment(Vec3 a, Vec3 b, double tolerance) const {
   return std::abs(la) < std::abs(lb) ? a : b;
 }
 
+bool IsoField::project_in_plane(Vec3& p, int axis, double max_distance, double tolerance) const {
+  const Vec3 start = p;
+  for (int it = 0; it < 30; ++it) {
+    Vec3 g;
+    const double l = level(p, g);
+    if (std::abs(l) <= tolerance) return true;
+    g[axis] = 0;
+    const double g2 = g.squaredNorm();
+    const double room = max_distance - (p - start).norm();
+    if (!(g2 > 0) || !(room > 0)) return false;
+    Vec3 step = -l * g / g2;
+    if (step.norm() > room) step *= room / step.norm();
+    const Vec3 z = p + step;
+    if ((level(z) > 0) != (l > 0)) {
+      p = root_on_segment(p, z, tolerance);
+      return std::abs(level(p)) <= tolerance;
+    }
+    p = z;
+  }
+  return false;
+}
+
 bool IsoField::project(Vec3& p, double max_distance, double tolerance) const {
   const Vec3 start = p;
   Vec3 g;

@@ -44,6 +44,12 @@ class IsoField {
   /// |L(p)| ≤ `tolerance` at the end; on failure `p` is the best point found.
   bool project(Vec3& p, double max_distance, double tolerance) const;
 
+  /// The same within the plane x_axis = p[axis] (the rim where the isosurface meets a box
+  /// face): Newton steps along the gradient's in-plane part, bisection once the zero is
+  /// bracketed, steps within `max_distance` of the start. Returns true when |L(p)| ≤
+  /// `tolerance` at the end.
+  bool project_in_plane(Vec3& p, int axis, double max_distance, double tolerance) const;
+
   /// The root of L on the segment [a, b] when L(a), L(b) have opposite signs (bisection to
   /// `tolerance` in |L| or to a segment of 1e-12 of its length).
   [[nodiscard]] Vec3 root_on_segment(Vec3 a, Vec3 b, double tolerance) const;

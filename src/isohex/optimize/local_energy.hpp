@@ -87,7 +87,9 @@ double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyPara
 /// certified_valid()): the validity every stage keeps.
 bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len);
 
-/// True when every hex around v (those flagged in `skip` left out) is hex_feasible() with v at x.
+/// True when every hex around v (those flagged in `skip` left out) is certified valid inside
+/// with v at x, as hex_feasible() asks: for a shape step whose energy is finite (so the frames v
+/// changes are feasible) from a place where every hex around v is hex_feasible().
 bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                     const Vec3& x, const std::vector<std::uint8_t>* skip);
 

@@ -42,9 +42,15 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
     auto p = mesh.corners(h);
     for (int k = 0; k < 8; ++k)
       if (mesh.hexes[h][k] == v) p[k] = x;
-    const double q = sj_value(p);
+    double q;
+    if (ratio) {  // both from one evaluation of the hex's Bernstein coefficients
+      const CertifiedQuality c = certified_quality(p);
+      q = is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian;
+      *ratio = std::min(*ratio, c.ratio_bound);
+    } else {
+      q = sj_value(p);
+    }
     lo = std::min(lo, q);
-    if (ratio) *ratio = std::min(*ratio, jacobian_ratio_bound(p));
     if (questionable) *questionable += q < kQuestionableSJ;
     if (!valid) continue;
     if (q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
@@ -58,57 +64,61 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
   return lo;
 }
 
-// The scaled Jacobians of the frames (of the hexes around v) that v's position changes, each
-// as its value and gradient in that position: det[a b c] / (|a| |b| |c|), the columns of
-// opt::frame(). Verdict's hex value is the minimum of these and of the frames v is not in.
-// With `value_only`, the gradients are left zero; with `ratio`, ratio_terms() come too.
-// The Bernstein coefficients of det J of each hex around v, divided by that hex's largest one
-// as the mesh stands (a constant of the move), as affine functions of v's place: each lattice
-// determinant is affine in one vertex (matrix determinant lemma) and the coefficients are
-// fixed combinations of them. Their minimum bounds the hex's jacobian ratio from below, so a
-// max–min move on them raises the element's interior, not only Verdict's nine samples. The
-// weight 2 puts a ratio of 0.1 (poor, kPoorJacobianRatio) level with a scaled Jacobian of 0.2.
-// Weighted by kRatioWeight against the scaled Jacobian's frame values.
+// The ratio terms are weighted kRatioWeight against the scaled Jacobian's frame values: 2 puts
+// a ratio of 0.1 (poor, kPoorJacobianRatio) level with a scaled Jacobian of 0.2.
 constexpr double kRatioWeight = 2;
 
+// The largest Bernstein coefficient of det J of each hex around v as the mesh stands (in
+// incidence order; 0 for a hex with none positive): the ratio terms' constant normalisation
+// during one move of v.
+std::vector<double> ratio_norms(const HexMesh& mesh, const Incidence& inc, Index v) {
+  std::vector<double> m;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const std::array<double, 27> b = jacobian_bernstein(mesh.corners(inc.ids[i]));
+    m.push_back(std::max(0.0, *std::max_element(b.begin(), b.end())));
+  }
+  return m;
+}
+
+// The Bernstein coefficients of det J of each hex around v over its norm, as affine functions
+// of v's place: each lattice determinant is affine in one vertex (matrix determinant lemma)
+// and the coefficients are fixed combinations of them. Their minimum bounds the hex's
+// jacobian ratio from below, so a max–min move on them raises the element's interior, not only
+// Verdict's nine samples.
 void ratio_terms(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool value_only,
-                 std::vector<opt::Affine>& out) {
-  constexpr double weight = kRatioWeight;
+                 const std::vector<double>& norms, std::vector<opt::Affine>& out) {
   const std::array<int, 27>& lattice = opt::lattice_frames();
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+    const double m = norms[static_cast<std::size_t>(i - inc.offsets[v])];
+    if (!(m > 0)) continue;
     const Index h = inc.ids[i];
     auto p = mesh.corners(h);
-    const std::array<double, 27> now = jacobian_bernstein(p);
-    const double m = *std::max_element(now.begin(), now.end());
-    if (!(m > 0)) continue;
     int k = 0;
     while (mesh.hexes[h][k] != v) ++k;
     p[k] = x;
-    std::array<opt::Affine, 27> f;
+    std::array<double, 27> b, gx, gy, gz;  // values and gradients, transformed alike
     for (int n = 0; n < 27; ++n) {
       const int t = lattice[static_cast<std::size_t>(n)];
       const opt::Mat3 A = opt::frame(p, t, 1.0);
-      f[n].b = weight * A.determinant() / m;
-      if (!value_only) f[n].a = (weight / m) * opt::det_gradient(A, opt::frame_coefficient(t, k));
+      b[n] = kRatioWeight * A.determinant() / m;
+      const Vec3 g = value_only ? Vec3::Zero() : Vec3((kRatioWeight / m) * opt::det_gradient(A, opt::frame_coefficient(t, k)));
+      gx[n] = g[0], gy[n] = g[1], gz[n] = g[2];
     }
-    // Values at 0, 1/2, 1 to quadratic Bernstein coefficients along each axis (linear, so the
-    // gradients transform alike).
-    const auto to_bernstein = [&](int a, int b, int c) {
-      f[b].b = 2 * f[b].b - 0.5 * (f[a].b + f[c].b);
-      f[b].a = 2 * f[b].a - 0.5 * (f[a].a + f[c].a);
-    };
-    for (int q = 0; q < 9; ++q) to_bernstein(3 * q, 3 * q + 1, 3 * q + 2);
-    for (int l = 0; l < 3; ++l)
-      for (int i2 = 0; i2 < 3; ++i2) to_bernstein(i2 + 9 * l, i2 + 3 + 9 * l, i2 + 6 + 9 * l);
-    for (int q = 0; q < 9; ++q) to_bernstein(q, q + 9, q + 18);
-    out.insert(out.end(), f.begin(), f.end());
+    lattice_to_bernstein(b);
+    if (!value_only) lattice_to_bernstein(gx), lattice_to_bernstein(gy), lattice_to_bernstein(gz);
+    for (int n = 0; n < 27; ++n) out.push_back({Vec3(gx[n], gy[n], gz[n]), b[n]});
   }
 }
 
+// The scaled Jacobians of the frames (of the hexes around v) that v's position changes, each
+// as its value and gradient in that position: det[a b c] / (|a| |b| |c|), the columns of
+// opt::frame(). Verdict's hex value is the minimum of these and of the frames v is not in.
+// With `value_only`, the gradients are left zero; with `norms` (ratio_norms()), ratio_terms()
+// come too.
 std::vector<opt::Affine> frame_values(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x,
-                                      bool value_only, bool ratio) {
+                                      bool value_only, const std::vector<double>* norms) {
   std::vector<opt::Affine> out;
-  if (ratio) ratio_terms(mesh, inc, v, x, value_only, out);
+  if (norms) ratio_terms(mesh, inc, v, x, value_only, *norms, out);
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     auto p = mesh.corners(h);
@@ -160,6 +170,8 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
   double ratio0 = 1;
   const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0, nullptr, 0, &ratio0);
   const double ratio_floor = std::min(ratio0, options.ratio_floor);
+  const std::vector<double> norms = options.ratio_terms ? ratio_norms(mesh, inc, v) : std::vector<double>{};
+  const std::vector<double>* ratio = options.ratio_terms ? &norms : nullptr;
   const double len = opt::mean_edge_at(mesh, inc, v);
   if (!(len > 0)) return false;
   const bool slides = surface && surface->role(v) == BoundarySurface::Role::slides;
@@ -167,7 +179,7 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
   double box = options.step * len;
   bool moved = false;
   for (int model = 0; model < options.models; ++model) {
-    std::vector<opt::Affine> f = frame_values(mesh, inc, v, x, false, options.ratio_terms);
+    std::vector<opt::Affine> f = frame_values(mesh, inc, v, x, false, ratio);
     const double now = lowest(f);
     // Frames at the target are good enough: no move there, and the model seeks no more (a
     // constant frame at the target caps the LP's bound), so the max–min step does not flatten
@@ -192,12 +204,12 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
       if (surface && !surface->put_back(v, y, n, len)) continue;  // off the surface (or band): refused
       bool valid = false;
       int below = 0;
-      double ratio = 1;
+      double ratio_y = 1;
       // A negative local minimum may rise while a valid neighbour is inverted on the way;
       // raising one hex by bending several others below 0.2 is no gain.
-      const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio);
-      if (!valid || below > below0 || q < m0 || ratio < ratio_floor ||
-          !(lowest(frame_values(mesh, inc, v, y, true, options.ratio_terms)) > now + 1e-9))
+      const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y);
+      if (!valid || below > below0 || q < m0 || ratio_y < ratio_floor ||
+          !(lowest(frame_values(mesh, inc, v, y, true, ratio)) > now + 1e-9))
         continue;
       x = y;
       gained = moved = true;
@@ -221,8 +233,13 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   std::vector<double> rank(mesh.hexes.size());
   const auto update = [&](Index h) {
     const auto p = mesh.corners(h);
-    sj[h] = sj_value(p);
-    rank[h] = options.ratio_terms ? std::min(sj[h], kRatioWeight * jacobian_ratio_bound(p)) : sj[h];
+    if (!options.ratio_terms) {
+      sj[h] = rank[h] = sj_value(p);
+      return;
+    }
+    const CertifiedQuality c = certified_quality(p);
+    sj[h] = is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian;
+    rank[h] = std::min(sj[h], kRatioWeight * c.ratio_bound);
   };
   for (Index h = 0; h < mesh.num_hexes(); ++h) update(h);
   const auto mesh_min = [&] { return sj.empty() ? 1.0 : *std::min_element(sj.begin(), sj.end()); };

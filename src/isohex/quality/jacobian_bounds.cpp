@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <queue>
+#include <tuple>
 
 namespace isohex {
 
@@ -32,8 +33,6 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
   return xu.dot(xv.cross(xw));
 }
 
-// Bernstein coefficients of a quadratic from its values at 0, 1/2, 1 of the interval.
-inline void to_bernstein(double& f0, double& f1, double& f2) { f1 = 2 * f1 - 0.5 * (f0 + f2); }
 
 // The 27 samples on the lattice of [lo, hi] and their Bernstein coefficients; `samples`
 // (values actually taken by det J) may be null.
@@ -46,13 +45,20 @@ std::array<double, 27> bernstein_box(const std::array<Vec3, 8>& q, const Vec3& l
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) b[i + 3 * j + 9 * k] = det_at(q, us[i], vs[j], ws[k]);
   if (samples) *samples = b;
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j < 3; ++j) to_bernstein(b[3 * j + 9 * k], b[1 + 3 * j + 9 * k], b[2 + 3 * j + 9 * k]);
-  for (int k = 0; k < 3; ++k)
-    for (int i = 0; i < 3; ++i) to_bernstein(b[i + 9 * k], b[i + 3 + 9 * k], b[i + 6 + 9 * k]);
-  for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i) to_bernstein(b[i + 3 * j], b[i + 3 * j + 9], b[i + 3 * j + 18]);
+  lattice_to_bernstein(b);
   return b;
+}
+
+// Child c of the box [lo, hi]: along axis a its upper half when bit a of c is set.
+std::pair<Vec3, Vec3> child(const Vec3& lo, const Vec3& hi, int c) {
+  const Vec3 mid = 0.5 * (lo + hi);
+  Vec3 l, h;
+  for (int a = 0; a < 3; ++a) {
+    const bool upper = (c >> a) & 1;
+    l[a] = upper ? mid[a] : lo[a];
+    h[a] = upper ? hi[a] : mid[a];
+  }
+  return {l, h};
 }
 
 struct Box {
@@ -119,14 +125,8 @@ class Subdivision {
   void split(std::size_t leaf) {
     alive_[leaf] = 0;
     const Box b = boxes_[leaf];
-    const Vec3 mid = 0.5 * (b.lo + b.hi);
     for (int c = 0; c < 8; ++c) {
-      Vec3 lo, hi;
-      for (int a = 0; a < 3; ++a) {
-        const bool upper = (c >> a) & 1;
-        lo[a] = upper ? mid[a] : b.lo[a];
-        hi[a] = upper ? b.hi[a] : mid[a];
-      }
+      const auto [lo, hi] = child(b.lo, b.hi, c);
       add(lo, hi);
     }
     drop_dead();
@@ -173,6 +173,34 @@ double abs_volume(const std::array<Vec3, 8>& p) {
   return sum / (n * n * n);
 }
 
+// certified_valid() from the element's own coefficients `b` and samples `s` (box [0,1]^3):
+// depth first on the boxes whose coefficients are not all above the floor; any sample at or
+// below it decides "not certified" at once.
+bool certify(const std::array<Vec3, 8>& q, std::array<double, 27> b, std::array<double, 27> s, double floor,
+             int max_subdivisions) {
+  std::vector<std::pair<Vec3, Vec3>> stack;
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Ones();
+  int splits = 0;
+  for (;;) {
+    if (!(*std::min_element(s.begin(), s.end()) > floor)) return false;
+    if (!(*std::min_element(b.begin(), b.end()) > floor)) {
+      if (++splits > max_subdivisions) return false;
+      for (int c = 0; c < 8; ++c) stack.push_back(child(lo, hi, c));
+    }
+    if (stack.empty()) return true;
+    std::tie(lo, hi) = stack.back();
+    stack.pop_back();
+    b = bernstein_box(q, lo, hi, &s);
+  }
+}
+
+// min / max of the element's coefficients (jacobian_ratio_bound()).
+double ratio_bound(const std::array<double, 27>& b) {
+  const auto [lo, hi] = std::minmax_element(b.begin(), b.end());
+  if (!(*hi > 0)) return *hi == 0 && *lo == 0 ? 0.0 : -1.0;
+  return std::max(-1.0, *lo / *hi);
+}
+
 // min / max clamped to [-1, 1]; an element negative everywhere is -1, a flat one 0.
 double ratio_of(const JacobianBounds& b) {
   if (!(b.max_upper > 0)) return b.max_upper == 0 && b.min_lower == 0 ? 0.0 : -1.0;
@@ -180,6 +208,18 @@ double ratio_of(const JacobianBounds& b) {
 }
 
 }  // namespace
+
+void lattice_to_bernstein(std::array<double, 27>& f) {
+  // Per axis, the quadratic through the values at 0, 1/2, 1 has Bernstein coefficients
+  // f(0), 2 f(1/2) - (f(0) + f(1))/2, f(1).
+  const auto line = [&](int a, int b, int c) { f[b] = 2 * f[b] - 0.5 * (f[a] + f[c]); };
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) line(3 * j + 9 * k, 1 + 3 * j + 9 * k, 2 + 3 * j + 9 * k);
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 3; ++i) line(i + 9 * k, i + 3 + 9 * k, i + 6 + 9 * k);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) line(i + 3 * j, i + 3 * j + 9, i + 3 * j + 18);
+}
 
 double jacobian_determinant(const std::array<Vec3, 8>& p, double u, double v, double w) {
   return det_at(relative(p), u, v, w);
@@ -210,30 +250,9 @@ double gauss_min_jacobian(const std::array<Vec3, 8>& p) {
 
 bool certified_valid(const std::array<Vec3, 8>& p, double floor, int max_subdivisions) {
   const std::array<Vec3, 8> q = relative(p);
-  // Depth-first on the boxes whose coefficients are not all above the floor; any sample at or
-  // below it decides "not certified" at once.
   std::array<double, 27> s;
-  std::vector<std::pair<Vec3, Vec3>> stack{{Vec3::Zero(), Vec3::Ones()}};
-  int splits = 0;
-  while (!stack.empty()) {
-    const auto [lo, hi] = stack.back();
-    stack.pop_back();
-    const std::array<double, 27> b = bernstein_box(q, lo, hi, &s);
-    if (!(*std::min_element(s.begin(), s.end()) > floor)) return false;
-    if (*std::min_element(b.begin(), b.end()) > floor) continue;
-    if (++splits > max_subdivisions) return false;
-    const Vec3 mid = 0.5 * (lo + hi);
-    for (int c = 0; c < 8; ++c) {
-      Vec3 l, h;
-      for (int a = 0; a < 3; ++a) {
-        const bool upper = (c >> a) & 1;
-        l[a] = upper ? mid[a] : lo[a];
-        h[a] = upper ? hi[a] : mid[a];
-      }
-      stack.push_back({l, h});
-    }
-  }
-  return true;
+  const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
+  return certify(q, b, s, floor, max_subdivisions);
 }
 
 double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
@@ -242,11 +261,15 @@ double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
   return certified_valid(p) ? sj : 0.0;
 }
 
-double jacobian_ratio_bound(const std::array<Vec3, 8>& p) {
-  const std::array<double, 27> b = jacobian_bernstein(p);
-  const auto [lo, hi] = std::minmax_element(b.begin(), b.end());
-  if (!(*hi > 0)) return *hi == 0 && *lo == 0 ? 0.0 : -1.0;
-  return std::max(-1.0, *lo / *hi);
+double jacobian_ratio_bound(const std::array<Vec3, 8>& p) { return ratio_bound(jacobian_bernstein(p)); }
+
+CertifiedQuality certified_quality(const std::array<Vec3, 8>& p) {
+  const std::array<Vec3, 8> q = relative(p);
+  std::array<double, 27> s;
+  const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
+  CertifiedQuality r{scaled_jacobian(p), ratio_bound(b)};
+  if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0 && !certify(q, b, s, 0, kCertifySubdivisions)) r.scaled_jacobian = 0;
+  return r;
 }
 
 std::vector<double> certified_scaled_jacobians(const HexMesh& mesh) {
@@ -269,14 +292,6 @@ MeshJacobians mesh_jacobians(const HexMesh& mesh) {
       r.valid[h] = b.valid() ? 1 : 0;
       r.gauss_min[h] = gauss_min_jacobian(p);
     }
-  });
-  return r;
-}
-
-std::vector<double> jacobian_ratios(const HexMesh& mesh) {
-  std::vector<double> r(mesh.hexes.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.size(), 256), [&](const auto& range) {
-    for (std::size_t h = range.begin(); h != range.end(); ++h) r[h] = jacobian_ratio(mesh.corners(static_cast<Index>(h)));
   });
   return r;
 }

@@ -34,6 +34,11 @@ double jacobian_determinant(const std::array<Vec3, 8>& p, double u, double v, do
 std::array<double, 27> jacobian_bernstein(const std::array<Vec3, 8>& p, const Vec3& lo = Vec3::Zero(),
                                           const Vec3& hi = Vec3::Ones());
 
+/// In place: values of a triquadratic at the 3×3×3 lattice of a box (index i + 3j + 9k for
+/// the point (i/2, j/2, k/2)) to its Bernstein coefficients. Linear, so it also carries the
+/// gradients of such values (one component at a time).
+void lattice_to_bernstein(std::array<double, 27>& f);
+
 /// Bounds of det J over the whole element, from adaptive Bernstein subdivision.
 struct JacobianBounds {
   double min_lower = 0;  ///< certified: det J >= min_lower everywhere in the element
@@ -71,11 +76,14 @@ double jacobian_ratio(const std::array<Vec3, 8>& p);
 /// integration) evaluates it (units of length^3).
 double gauss_min_jacobian(const std::array<Vec3, 8>& p);
 
+/// The subdivisions certified_valid() tries before it calls an element undecided (not valid).
+inline constexpr int kCertifySubdivisions = 64;
+
 /// True when the element is certified valid with det J >= `floor` everywhere: the 27
 /// Bernstein coefficients of the element, and if needed of up to `max_subdivisions` sub-boxes,
 /// are all >= floor. Sufficient, never optimistic: false when undecided. The cheap test that
 /// the optimisers run on every move.
-bool certified_valid(const std::array<Vec3, 8>& p, double floor = 0, int max_subdivisions = 64);
+bool certified_valid(const std::array<Vec3, 8>& p, double floor = 0, int max_subdivisions = kCertifySubdivisions);
 
 /// Verdict's scaled Jacobian where the element is certified valid inside (certified_valid()),
 /// and min(scaled Jacobian, 0) where it is not: the measure every optimisation stage keeps, so
@@ -99,11 +107,16 @@ struct MeshJacobians {
 };
 MeshJacobians mesh_jacobians(const HexMesh& mesh);
 
+/// certified_scaled_jacobian() and jacobian_ratio_bound() of one hex from one evaluation of
+/// its coefficients (the worst-element pass needs both for every trial move).
+struct CertifiedQuality {
+  double scaled_jacobian;
+  double ratio_bound;
+};
+CertifiedQuality certified_quality(const std::array<Vec3, 8>& p);
+
 /// certified_scaled_jacobian() of every hex (parallel, bit-identical for any thread count).
 std::vector<double> certified_scaled_jacobians(const HexMesh& mesh);
-
-/// jacobian_ratio() of every hex (parallel).
-std::vector<double> jacobian_ratios(const HexMesh& mesh);
 
 /// The volume of the hexes against the volume their boundary encloses. Signed volumes of a
 /// conforming mesh always add up to the enclosed volume (the interior faces cancel), so the

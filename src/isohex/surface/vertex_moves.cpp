@@ -2,6 +2,7 @@
 
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/jacobian_bounds.hpp"
+#include "isohex/volume/implicit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -71,9 +72,8 @@ namespace {
 // along it.
 bool in_volume(const MoveContext& ctx, const Vec3& y) {
   const Volume& vol = ctx.field.volume();
-  const Vec3 lo = vol.origin, hi = vol.max_corner();
-  const double slack = 1e-9 * (hi - lo).norm();
-  return !((y.array() < lo.array() - slack).any() || (y.array() > hi.array() + slack).any());
+  const Aabb box{vol.origin, vol.max_corner()};
+  return box.contains(y, 1e-9 * (box.hi - box.lo).norm());
 }
 
 bool constrain_to_surface(const MoveContext& ctx, Index v, Vec3& y, double reach) {
@@ -81,26 +81,7 @@ bool constrain_to_surface(const MoveContext& ctx, Index v, Vec3& y, double reach
   if (a < 0) return ctx.field.project(y, reach, ctx.level_tolerance) && y.allFinite();
   y[a] = ctx.mesh.points[v][a];
   if (!on_rim(ctx, v)) return y.allFinite();
-  // Newton steps along the gradient's in-plane part; bisection once the zero is bracketed.
-  const Vec3 start = y;
-  for (int it = 0; it < 30; ++it) {
-    Vec3 g;
-    const double l = ctx.field.level(y, g);
-    if (std::abs(l) <= ctx.level_tolerance) return y.allFinite();
-    g[a] = 0;
-    const double g2 = g.squaredNorm();
-    const double room = reach - (y - start).norm();
-    if (!(g2 > 0) || !(room > 0)) return false;
-    Vec3 step = -l * g / g2;
-    if (step.norm() > room) step *= room / step.norm();
-    const Vec3 z = y + step;
-    if ((ctx.field.level(z) > 0) != (l > 0)) {
-      y = ctx.field.root_on_segment(y, z, ctx.level_tolerance);
-      return std::abs(ctx.field.level(y)) <= ctx.level_tolerance && y.allFinite();
-    }
-    y = z;
-  }
-  return false;
+  return ctx.field.project_in_plane(y, a, reach, ctx.level_tolerance) && y.allFinite();
 }
 
 }  // namespace

@@ -116,6 +116,10 @@ struct Aabb {
   Vec3 lo, hi;
   [[nodiscard]] bool is_finite() const { return lo.allFinite() && hi.allFinite(); }
   [[nodiscard]] bool is_empty() const { return (lo.array() > hi.array()).any(); }
+  /// True when p is in the box, or outside it by at most `slack` along every axis.
+  [[nodiscard]] bool contains(const Vec3& p, double slack = 0) const {
+    return !((p.array() < lo.array() - slack).any() || (p.array() > hi.array() + slack).any());
+  }
 };
 
 /// A box containing the shape: tight for the primitives, the union / intersection of the
