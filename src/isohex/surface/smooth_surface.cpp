@@ -74,6 +74,7 @@ void check_inputs(const HexMesh& mesh, const IsoField& field, const SurfaceSmoot
   check_range("level_tolerance", o.level_tolerance, 1e-15, kSurfaceGuarantee);
   check_range("projection_reach", o.projection_reach, 1e-6, 100);
   check_range("convergence", o.convergence, 0, 1);
+  check_range("max_travel", o.max_travel, 1e-6, 100);
   check_range("worst_passes", o.worst_passes, 0, 1e6);
   check_range("worst_target", o.worst_target, 0, 1);
   check_range("worst_radius", o.worst_radius, 1e-9, 2);
@@ -307,6 +308,11 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
         [&](Index v) { return surface_detail::move_boundary_vertex(ctx, v, Vec3::Zero()); });
   report.projected = quality_of(mesh, graph);
   ctx.quad_hard_floor = report.projected.quad_sj_min;
+  const std::vector<Vec3> anchor = mesh.points;
+  std::vector<double> travel(static_cast<std::size_t>(nv), 0.0);
+  for (Index v : boundary) travel[v] = options.max_travel * surface_detail::mean_boundary_edge(ctx, v);
+  ctx.anchor = &anchor;
+  ctx.travel = &travel;
 
   for (int it = 0; it < options.iterations; ++it) {
     before_iteration = mesh.points;

@@ -76,6 +76,10 @@ struct SurfaceSmoothingOptions {
   double field_crease_angle_degrees = 30;
   double level_tolerance = 1e-7;      ///< projection target |L| ≤ this × the field's value range, in (0, 1e-6]
   double projection_reach = 1.0;      ///< largest projection distance, × the vertex's mean boundary edge length
+  /// Farthest a boundary vertex may move from where it is once on the isosurface, × its mean
+  /// boundary edge there, > 0: relaxation and max–min moves improve the quads around a vertex,
+  /// they must not carry it along the surface (see within_travel() in vertex_moves.hpp).
+  double max_travel = 1.0;
   double convergence = 1e-4;          ///< stop once no vertex moved more than this × the mean boundary edge length
   /// Check the hexes as well as the boundary quads. Off when a boundary pillow follows: the
   /// pillow gives every boundary quad a new hex and the hexes below are re-shaped anyway,

@@ -29,6 +29,8 @@ double quad_sj(const HexMesh& mesh, const Quad& q, Index v, const Vec3& y) {
   return quad_scaled_jacobian(c);
 }
 
+}  // namespace
+
 double mean_boundary_edge(const MoveContext& ctx, Index v) {
   const auto& nb = ctx.graph.boundary_neighbours;
   double sum = 0;
@@ -37,8 +39,6 @@ double mean_boundary_edge(const MoveContext& ctx, Index v) {
   const Index n = nb.offsets[v + 1] - nb.offsets[v];
   return n > 0 ? sum / n : 0.0;
 }
-
-}  // namespace
 
 Vec3 quads_normal(const MoveContext& ctx, Index v) {
   Vec3 n = Vec3::Zero();
@@ -85,6 +85,11 @@ bool constrain_to_surface(const MoveContext& ctx, Index v, Vec3& y, double reach
 }
 
 }  // namespace
+
+bool within_travel(const MoveContext& ctx, Index v, const Vec3& y) {
+  if (!ctx.anchor || !ctx.travel) return true;
+  return ((*ctx.anchor)[v] - y).squaredNorm() <= (*ctx.travel)[v] * (*ctx.travel)[v];
+}
 
 bool constrain(const MoveContext& ctx, Index v, Vec3& y, double reach) {
   return constrain_to_surface(ctx, v, y, reach) && in_volume(ctx, y);
@@ -194,7 +199,7 @@ MoveOutcome move_boundary_vertex(const MoveContext& ctx, Index v, const Vec3& st
     double scale = 1;
     for (int k = 0; k <= ctx.max_halvings; ++k, scale *= 0.5) {
       Vec3 y = x + scale * step;
-      if (constrain(ctx, v, y, reach) && move_is_acceptable(ctx, v, y, true, Check::relax)) {
+      if (constrain(ctx, v, y, reach) && within_travel(ctx, v, y) && move_is_acceptable(ctx, v, y, true, Check::relax)) {
         ctx.mesh.points[v] = y;
         return k == 0 ? MoveOutcome::accepted : MoveOutcome::halved;
       }

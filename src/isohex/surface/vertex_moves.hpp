@@ -41,6 +41,10 @@ struct MoveContext {
   /// through it (a domain-box face) instead of on the isosurface; a + 3: it slides along the
   /// rim where that plane meets the isosurface.
   const std::vector<std::int8_t>* planar = nullptr;
+  /// Per vertex (or empty): where its smoothing moves started and how far from there a move
+  /// may take it (within_travel()).
+  const std::vector<Vec3>* anchor = nullptr;
+  const std::vector<double>* travel = nullptr;
 };
 
 /// The axis of the plane `v` stays in, or −1.
@@ -55,6 +59,15 @@ inline bool on_rim(const MoveContext& ctx, Index v) {
 
 /// True if `v` slides in a box face (off the isosurface), not on the isosurface or its rim.
 inline bool in_box_face(const MoveContext& ctx, Index v) { return plane_axis(ctx, v) >= 0 && !on_rim(ctx, v); }
+
+/// Mean length of the boundary edges at `v` (0 for none).
+double mean_boundary_edge(const MoveContext& ctx, Index v);
+
+/// True if `y` is within `travel[v]` of `anchor[v]` (always, without them). Smoothing moves
+/// equalise quads, they do not transport vertices: unbounded, the max–min pass carried
+/// vertices of cthead's one-cell-thick table plate 178 mm along it in 40 passes (each step
+/// improved its quads' scores), and the optimiser inherited hexes 60 mm long.
+bool within_travel(const MoveContext& ctx, Index v, const Vec3& y);
 
 /// Unit normal of the boundary at `v` from its quads (the sum of their area vectors).
 Vec3 quads_normal(const MoveContext& ctx, Index v);

@@ -165,7 +165,7 @@ MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int
     for (int d = 0; d < kDirections; ++d) {
       const double t = 2 * std::numbers::pi * d / kDirections;
       Vec3 y = x + step * (std::cos(t) * a + std::sin(t) * b);
-      if (!constrain(ctx, v, y, 2 * edge)) continue;
+      if (!constrain(ctx, v, y, 2 * edge) || !within_travel(ctx, v, y)) continue;
       const Score value = score_around(ctx, v, y, turned, cap);
       if (value.beats(best_score) && hexes_allow(ctx, v, y)) {
         best_score = value;
