@@ -151,11 +151,8 @@ MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int
   const Vec3 a = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
   const Vec3 b = n.cross(a);
   const auto& nb = ctx.graph.boundary_neighbours;
-  double edge = 0;
-  for (Index k = nb.offsets[v]; k < nb.offsets[v + 1]; ++k) edge += (ctx.mesh.points[nb.ids[k]] - x).norm();
-  const Index count = nb.offsets[v + 1] - nb.offsets[v];
-  if (count == 0) return MoveOutcome::none;
-  edge /= count;
+  if (nb.offsets[v + 1] == nb.offsets[v]) return MoveOutcome::none;
+  const double edge = mean_boundary_edge(ctx, v);
 
   Vec3 best = x;
   Score best_score = current;
