@@ -379,7 +379,11 @@ void run(const Args& a) {
     }
   }
   // A mesh a solver would refuse fails the run (it is written all the same, for inspection).
-  if (!check.valid() || dist.off_surface > 0 || released_far > band * (1 + 1e-3) || inverted_left > 0) exit_code() = 1;
+  // Without the optimisation (--no-smooth) the raw or pillowed mesh is asked for as it is (a
+  // pillow without the surface smoothing may place inner copies outside the domain, headsq: 46).
+  const bool unfit = !a.no_smooth && (validity.not_valid_inside > 0 || validity.gauss_nonpositive > 0 || outside_domain > 0);
+  if (!check.valid() || dist.off_surface > 0 || released_far > band * (1 + 1e-3) || inverted_left > 0 || unfit)
+    exit_code() = 1;
 }
 
 }  // namespace

@@ -79,6 +79,12 @@ def other_sizes(data):
         ("headsq (bone, h 2)", None, [v("headsq_64x64x93_int16le.raw"), "--iso", "1150", "--cell-size", "2"] + HEADSQ, None),
         ("headsq (bone, h 4)", None, [v("headsq_64x64x93_int16le.raw"), "--iso", "1150", "--cell-size", "4"] + HEADSQ, None),
         ("MR head (iso 40, h 3)", None, [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "3"], None),
+        # The other volumes of scripts/pillow_table.py, and a bone isosurface thinner than a cell.
+        ("bucky (iso 51, h 1)", None, [v("bucky_32x32x32_uint8.raw"), "--dims", "32", "32", "32", "--type", "u8",
+                                       "--iso", "51", "--cell-size", "1"], None),
+        ("ironProt (iso 128, h 1)", None, [v("ironProt.vtk"), "--iso", "128", "--cell-size", "1"], None),
+        ("cthead (bone, iso 1200, h 5)", None, [v("cthead_256x256x113_int16be.raw"), "--iso", "1200", "--cell-size", "5"]
+         + CTHEAD, None),
     ]
 
 

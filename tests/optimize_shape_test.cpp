@@ -64,6 +64,20 @@ TEST(OptimizeShape, DerivativesMatchFiniteDifferences) {
   // Inverted neighbourhood: the regularised energy stays smooth there.
   m.points[v] += Vec3(0.5, 0.4, 0.3);
   check_derivatives(m, v, opt::EnergyParams{true, 0.05, 0.5});
+  // With every hex counting its interior frames and det J's Bernstein coefficients (the
+  // untangler's terms for hexes not certified valid inside).
+  const std::vector<std::uint8_t> all(m.hexes.size(), 1);
+  opt::EnergyParams b{true, 0.05, 0.5};
+  b.interior = b.bernstein = &all;
+  check_derivatives(m, v, b);
+  // The coefficients change the energy: a hex of the lattice frames only has another.
+  const Incidence inc = vertex_hexes(m);
+  const std::vector<double> il = opt::inverse_edge_lengths(m);
+  opt::EnergyParams frames_only = b;
+  frames_only.bernstein = nullptr;
+  EXPECT_GT(std::abs(opt::vertex_energy(m, inc, il, v, m.points[v], b) -
+                     opt::vertex_energy(m, inc, il, v, m.points[v], frames_only)),
+            1e-6);
 }
 
 TEST(OptimizeShape, ColoringSeparatesVerticesOfEachHex) {

@@ -74,3 +74,22 @@ TEST(OptimizeValidity, UntanglerRepairsAFoldBetweenVerdictsSamples) {
   const MeshJacobians after = mesh_jacobians(m);
   EXPECT_EQ(std::count(after.valid.begin(), after.valid.end(), 0), 0);
 }
+
+// A pillow hex of cthead's bone at h 5 (iso 1200) that the untangler once left folded on a
+// side face (min det J -10 against a max of 402; all 8 corners positive): its boundary quad
+// fixed, its inner face free. The untangler must find a place that certifies it.
+TEST(OptimizeValidity, UntanglerCertifiesAPillowHexFoldedOnASideFace) {
+  HexMesh m;
+  m.points = {{74.356398, 71.630073, 172.717386}, {77.212710, 72.524009, 171.702752},
+              {67.293245, 85.950662, 175.474016}, {71.896603, 72.388942, 177.815059},
+              {72.687742, 71.548922, 174.528996}, {78.345319, 74.062944, 172.216483},
+              {74.328825, 78.343600, 177.254988}, {72.915504, 74.354524, 177.274097}};
+  m.hexes = {{0, 1, 2, 3, 4, 5, 6, 7}};
+  ASSERT_FALSE(jacobian_bounds(m.corners(0)).valid());
+  const std::vector<std::uint8_t> fixed = {1, 1, 1, 1, 0, 0, 0, 0};
+  const UntangleResult r = untangle(m, fixed, UntangleOptions{});
+  EXPECT_EQ(r.inverted, 0u);
+  const JacobianBounds b = jacobian_bounds(m.corners(0));
+  EXPECT_TRUE(b.valid()) << b.min_lower;
+  EXPECT_TRUE(sampled_positive(m.corners(0), 17));
+}

@@ -122,6 +122,14 @@ Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
   return shape_term(F, D);
 }
 
+// The Bernstein coefficients of det J of the hex p (at the frames' scale inv_len³) that are
+// not corner values (those are frames already), as the energy's extra terms: each coefficient
+// is affine in one vertex's place (every lattice determinant is, by the matrix determinant
+// lemma, and the coefficients are fixed combinations of them), so its term's Hessian is
+// f''(b) ∇b ∇bᵀ. With `g`, the gradient and Hessian in corner k's place are added.
+double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, const EnergyParams& params, double eps,
+                        Vec3* g, Mat3* H);
+
 }  // namespace
 
 const Vec3& frame_coefficient(int t, int k) { return kCoef[t][k]; }
@@ -146,6 +154,43 @@ const std::array<int, 27>& lattice_frames() {
   }();
   return map;
 }
+
+namespace {
+
+double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, const EnergyParams& params, double eps,
+                        Vec3* g, Mat3* H) {
+  const std::array<int, 27>& lattice = lattice_frames();
+  std::array<double, 27> b, gx, gy, gz;  // values and gradients, transformed alike
+  for (int n = 0; n < 27; ++n) {
+    const int t = lattice[static_cast<std::size_t>(n)];
+    const Mat3 A = frame(p, t, inv_len);
+    b[n] = A.determinant();
+    if (!g) continue;
+    const Vec3& c = kCoef[t][k];
+    const Vec3 gD = inv_len * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) +
+                               c[2] * A.col(0).cross(A.col(1)));
+    gx[n] = gD[0], gy[n] = gD[1], gz[n] = gD[2];
+  }
+  lattice_to_bernstein(b);
+  if (g) lattice_to_bernstein(gx), lattice_to_bernstein(gy), lattice_to_bernstein(gz);
+  // ε floored: a coefficient barely below 0 with ε of its size would give a term ~ 1/|b|
+  // (the energy grew to 1e20 on a knot that cannot be undone); 1e-3 of a unit cube's det J
+  // still presses a negative coefficient with a gradient of ~1e6.
+  eps = std::max(eps, 1e-3);
+  double e = 0;
+  for (int n = 0; n < 27; ++n) {
+    if (n == 0 || n == 2 || n == 6 || n == 8 || n == 18 || n == 20 || n == 24 || n == 26) continue;  // corners
+    const Scalar s = untangle_term(0, b[n], eps, params.lambda);
+    e += s.f;
+    if (!g) continue;
+    const Vec3 gb(gx[n], gy[n], gz[n]);
+    *g += s.fD * gb;
+    if (H) *H += s.fDD * (gb * gb.transpose());
+  }
+  return e;
+}
+
+}  // namespace
 
 std::vector<double> inverse_edge_lengths(const HexMesh& mesh) {
   std::vector<double> inv(mesh.hexes.size());
@@ -184,6 +229,13 @@ double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyPara
   return e;
 }
 
+double hex_energy(const std::array<Vec3, 8>& p, Index h, double inv_len, const EnergyParams& params) {
+  const double eps = params.eps_of(h);
+  double e = hex_energy(p, inv_len, params, eps, params.frames_of(h));
+  if (params.bernstein_of(h)) e += bernstein_energy(p, 0, inv_len, params, eps, nullptr, nullptr);
+  return e;
+}
+
 bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len) {
   for (int t = 0; t < kFrames; ++t)
     if (!(frame(p, t, inv_len).determinant() > kMinFeasibleDet)) return false;
@@ -191,13 +243,15 @@ bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len) {
 }
 
 bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
-                    const Vec3& x, const std::vector<std::uint8_t>* skip) {
+                    const Vec3& x, const std::vector<std::uint8_t>* skip, const std::vector<double>* ratio_floor) {
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     if (skip && (*skip)[h]) continue;
     std::array<Vec3, 8> p = mesh.corners(h);
     for (int k = 0; k < 8; ++k)
       if (mesh.hexes[h][k] == v) p[k] = x;
+    if (ratio_floor && jacobian_ratio_bound(p) < (*ratio_floor)[static_cast<std::size_t>(i - inc.offsets[v])])
+      return false;
     // Only the certificate: a finite shape energy has checked the frames v changes already,
     // and the others are those of a hex that was feasible.
     if (!certified_valid(p, kMinFeasibleDet / (inv_len[h] * inv_len[h] * inv_len[h]))) return false;
@@ -237,6 +291,10 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
         *H += (s.fF * 2 * il * il * c.squaredNorm()) * Mat3::Identity();
         *H += s.fFD * (gF * gD.transpose() + gD * gF.transpose()) + s.fDD * (gD * gD.transpose());
       }
+    }
+    if (params.bernstein_of(h)) {
+      e += bernstein_energy(p, k, il, params, eps, g, H);
+      if (!std::isfinite(e)) return kInf;
     }
   }
   return e;
@@ -278,6 +336,15 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   if (!(dn > 0)) return m;
   if (dn > len) d *= len / dn;  // never jump further than an edge in one step
   const double slope = g.dot(d);
+  // The shape stage's mean objective may trade one hex's interior for the others: no step
+  // takes a hex's ratio bound from kShapeRatioFloor or above to below it. (Holding the poor
+  // hexes where they are too held the first stage back: the MR head's mean inverse mean ratio
+  // ended at 1.89 instead of 1.56, and 14 hexes below 0.2 were left instead of 4.)
+  std::vector<double> ratio_floor;
+  if (!params.untangle)
+    for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+      ratio_floor.push_back(jacobian_ratio_bound(mesh.corners(inc.ids[i])) >= kShapeRatioFloor ? kShapeRatioFloor
+                                                                                                : -kInf);
   double t = 1;
   for (int i = 0; i < 30; ++i, t *= 0.5) {
     Vec3 x = m.x + t * d;
@@ -285,7 +352,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
     const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
     // The shape stage's barrier sees the 9 frames only: a step must also keep every hex
     // around v certified valid inside (hex_feasible()), or a fold could open between them.
-    if (e < e0 && e <= e0 + 1e-4 * t * slope && (params.untangle || stays_feasible(mesh, inc, inv_len, v, x, params.skip))) {
+    if (e < e0 && e <= e0 + 1e-4 * t * slope && (params.untangle || stays_feasible(mesh, inc, inv_len, v, x, params.skip, &ratio_floor))) {
       m.x = x;
       m.moved = true;
       break;
@@ -300,8 +367,7 @@ double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, con
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h)
       if (skip.empty() || !skip[h])
-        e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), inv_len[h], params, params.eps_of(static_cast<Index>(h)),
-                          params.frames_of(static_cast<Index>(h)));
+        e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), static_cast<Index>(h), inv_len[h], params);
   });
   double sum = 0;
   for (double x : e) sum += x;  // in hex order: the same bits for any thread count

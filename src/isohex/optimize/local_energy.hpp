@@ -54,6 +54,13 @@ struct EnergyParams {
   /// Hexes whose energy also counts the interior frames 9..34 (may be null: none). In the
   /// shape stage these frames only constrain (like the centre frame).
   const std::vector<std::uint8_t>* interior = nullptr;
+  /// untangle: hexes whose energy also counts det J's Bernstein coefficients (may be null:
+  /// none): the untangler's hexes that are not certified valid inside now. Their 27 lattice
+  /// samples may all be positive while det J is negative between them (on a face, say): the
+  /// coefficients bound det J from below, and all of them positive certifies the hex.
+  const std::vector<std::uint8_t>* bernstein = nullptr;
+  /// Whether hex h counts its Bernstein coefficients (untangle only).
+  bool bernstein_of(Index h) const { return untangle && bernstein && (*bernstein)[static_cast<std::size_t>(h)]; }
   /// The number of frames hex h contributes.
   int frames_of(Index h) const { return interior && (*interior)[static_cast<std::size_t>(h)] ? kAllFrames : kFrames; }
   /// ε of hex h under these parameters.
@@ -82,6 +89,10 @@ const Vec3& frame_coefficient(int t, int k);
 double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps = -1,
                   int frames = kFrames);
 
+/// The energy hex h (corners p) contributes under `params`: its frames_of(h) frames, and its
+/// Bernstein coefficients where bernstein_of(h).
+double hex_energy(const std::array<Vec3, 8>& p, Index h, double inv_len, const EnergyParams& params);
+
 /// True when all 9 frames of the hex have determinant > kMinFeasibleDet and the hex is
 /// certified valid inside with det J > kMinFeasibleDet · L³ everywhere (Bernstein bounds,
 /// certified_valid()): the validity every stage keeps.
@@ -90,8 +101,15 @@ bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len);
 /// True when every hex around v (those flagged in `skip` left out) is certified valid inside
 /// with v at x, as hex_feasible() asks: for a shape step whose energy is finite (so the frames v
 /// changes are feasible) from a place where every hex around v is hex_feasible().
+/// With `ratio_floor` (one value per hex around v, in incidence order), also that no hex's
+/// jacobian_ratio_bound() falls below its floor.
 bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
-                    const Vec3& x, const std::vector<std::uint8_t>* skip);
+                    const Vec3& x, const std::vector<std::uint8_t>* skip,
+                    const std::vector<double>* ratio_floor = nullptr);
+
+/// No shape step takes a hex's jacobian_ratio_bound() from this or above to below it (a ratio
+/// of 0.1 is poor, kPoorJacobianRatio; the bound is at most the ratio).
+inline constexpr double kShapeRatioFloor = 0.1;
 
 /// The energy of the hexes around vertex v with v placed at x; with g and H, also its gradient
 /// and Hessian with respect to x (the Hessian of the regularised energy may be indefinite).

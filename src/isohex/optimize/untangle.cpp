@@ -27,6 +27,11 @@ std::vector<double> hex_min_det(const HexMesh& mesh, const std::vector<double>& 
       const auto p = mesh.corners(static_cast<Index>(h));
       const int frames = params.frames_of(static_cast<Index>(h));
       for (int t = 0; t < frames; ++t) d[h] = std::min(d[h], opt::frame(p, t, inv_len[h]).determinant());
+      if (params.bernstein_of(static_cast<Index>(h))) {  // the coefficients the energy counts
+        const std::array<double, 27> b = jacobian_bernstein(p);
+        const double s = inv_len[h] * inv_len[h] * inv_len[h];
+        for (double x : b) d[h] = std::min(d[h], x * s);
+      }
     }
   });
   return d;
@@ -138,7 +143,12 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   // Hexes that have not been valid inside count their interior frames too (from the first
   // time they are seen so, to the end): the 9 frames alone cannot see their fold.
   std::vector<std::uint8_t> interior(mesh.hexes.size(), 0);
+  // Hexes not certified valid inside now also count det J's Bernstein coefficients: their 35
+  // samples may all be positive with det J negative between them (cthead's bone at h 5 kept
+  // such a pillow hex, min det J on a side face, through every round).
+  std::vector<std::uint8_t> bernstein(mesh.hexes.size(), 0);
   opt::EnergyParams params{true, 1.0, options.lambda, skipped, options.surface, &hex_eps, &interior};
+  params.bernstein = &bernstein;
   const std::vector<std::uint8_t> no_skip;
   const std::vector<std::uint8_t>& energy_skip = skipped ? skip : no_skip;
   // Per hex: the best (highest) smallest frame determinant seen while inverted, and when.
@@ -159,8 +169,10 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   opt::SJStats best = stats;
   res.stop = "max_iter";
   for (int it = 1; it <= options.max_iter; ++it) {
-    for (std::size_t h = 0; h < sj.size(); ++h)
-      if (sj[h] <= 0 || is_degenerate(sj[h])) interior[h] = 1;
+    for (std::size_t h = 0; h < sj.size(); ++h) {
+      bernstein[h] = sj[h] <= 0 || is_degenerate(sj[h]);
+      if (bernstein[h]) interior[h] = 1;
+    }
     const double e_before = opt::total_energy(mesh, inv_len, params, energy_skip);
     const std::vector<std::uint8_t> frozen = frozen_outside(mesh, inc, sj, options.margin, options.rings, skipped);
     for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2);
