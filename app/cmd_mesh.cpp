@@ -250,9 +250,10 @@ void run(const Args& a) {
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
              out.mesh.num_hexes(), out.mesh.num_vertices(), dist.checked, dist.box_vertices, check.num_boundary_quads);
   fmt::print("  manifold repair: {} points made outside, {} made inside in {} rounds ({} simple and {} relocated, "
-             "topology kept; {} forced; {} filling {} zero-volume cavities; {} simple at the isovalue); {} cells split\n",
+             "topology kept; {} forced; {} filling {} zero-volume cavities; {} simple at the isovalue; {} filling pinches "
+             "of zero width); {} cells split\n",
              r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.relocated_points, r.forced_points,
-             r.degenerate_points, r.degenerate_components, r.zero_level_points, r.split_cells);
+             r.degenerate_points, r.degenerate_components, r.zero_level_points, r.pinch_points, r.split_cells);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -261,8 +262,9 @@ void run(const Args& a) {
   for (const Fault& f : check.faults)
     if (is_error(f.kind)) fmt::print("    {}\n", f.message);
   fmt::print("  distance to the isosurface: max |f - iso| / range = {:.3g} over {} vertices ({} above 1e-6; {} box "
-             "vertices not checked; {} projection fallbacks)\n",
-             dist.max_relative, dist.checked, dist.off_surface, dist.box_vertices, r.projection_fallbacks);
+             "vertices not checked; {} projection fallbacks; {} placed again apart from a neighbour's)\n",
+             dist.max_relative, dist.checked, dist.off_surface, dist.box_vertices, r.projection_fallbacks,
+             r.separated_vertices);
   // The vertices released into the band (--surface-band), apart: their distance in world units.
   double released_far = 0, band = 0;
   const auto num_released = static_cast<std::size_t>(std::count(released.begin(), released.end(), 1));
@@ -322,6 +324,7 @@ void run(const Args& a) {
     j["degenerate_components"] = r.degenerate_components;
     j["degenerate_points"] = r.degenerate_points;
     j["zero_level_points"] = r.zero_level_points;
+    j["pinch_points"] = r.pinch_points;
     // Every sample the repair flipped, so that the topology claims can be checked.
     nlohmann::json edits = nlohmann::json::array();
     for (const auto& e : r.edits) {
@@ -333,6 +336,7 @@ void run(const Args& a) {
                                 : e.kind == contour::RepairKind::relocated  ? "relocated"
                                 : e.kind == contour::RepairKind::degenerate ? "degenerate"
                                 : e.kind == contour::RepairKind::zero_level ? "zero_level"
+                                : e.kind == contour::RepairKind::pinch      ? "pinch"
                                                                             : "forced"}});
     }
     j["repair_edits"] = edits;
@@ -342,6 +346,7 @@ void run(const Args& a) {
     j["surface_vertices"] = r.surface_vertices;
     j["box_vertices"] = r.box_vertices;
     j["projection_fallbacks"] = r.projection_fallbacks;
+    j["separated_vertices"] = r.separated_vertices;
     j["max_relative_distance"] = dist.max_relative;
     j["off_surface_vertices"] = dist.off_surface;
     j["released_vertices"] = dist.released;

@@ -163,6 +163,32 @@ std::vector<double> round_ranks(const HexMesh& mesh, RoundScore& score) {
   return sj;
 }
 
+// The boundary vertices of the hexes below 0.2 by `rank` and of the hexes within `reach`
+// vertex-sharing rings of them, sorted and unique.
+std::vector<Index> release_candidates(const HexMesh& mesh, const Incidence& inc, const BoundarySurface& surface,
+                                      const std::vector<double>& rank, int reach) {
+  std::vector<std::uint8_t> in(mesh.num_hexes(), 0);
+  std::vector<Index> ring;
+  for (Index h = 0; h < mesh.num_hexes(); ++h)
+    if (rank[h] < kQuestionableSJ || is_degenerate(rank[h])) in[h] = 1, ring.push_back(h);
+  for (int r = 0; r < reach; ++r) {
+    std::vector<Index> next;
+    for (Index h : ring)
+      for (Index v : mesh.hexes[h])
+        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+          if (!in[inc.ids[k]]) in[inc.ids[k]] = 1, next.push_back(inc.ids[k]);
+    ring = std::move(next);
+  }
+  std::vector<Index> candidates;
+  for (Index h = 0; h < mesh.num_hexes(); ++h)
+    if (in[h])
+      for (Index v : mesh.hexes[h])
+        if (surface.role(v) != BoundarySurface::Role::interior) candidates.push_back(v);
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  return candidates;
+}
+
 }  // namespace
 
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& o) {
@@ -176,7 +202,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
   // vertex); they stop as soon as a round releases nothing (cthead h 4 needed 5). A round
   // that leaves the mesh worse by RoundScore is undone and ends them: its shape stage may
   // trade a minimum for the mean (cthead h 4: 0.205 -> 0.194 in its fifth round).
-  constexpr int kRings = 3;
+  constexpr int kRings = 3, kMaxReach = 3;
   // The rounds' worst passes work on a few hundred vertices, and still gained at the first
   // stage's 30 passes (headsq: 0.097 -> 0.174 in its second round's 30).
   OptimizeOptions rounds = o;
@@ -187,23 +213,16 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
   for (int round = 1; round <= 5; ++round) {
     // Hexes that need the release: below 0.2 by the certified scaled Jacobian, or valid inside
     // with a jacobian ratio below 0.1 (a fold about to open: the worst pass ranks them alike).
+    // When the reach of this round releases nothing new (all of it is loose already and a
+    // hex is still below: cthead h 4 stopped at 0.182 in a pillow hex), it grows by a ring.
     std::vector<Index> candidates;
-    const auto add = [&](Index h) {
-      for (Index v : mesh.hexes[h])
-        if (surface.role(v) != BoundarySurface::Role::interior) candidates.push_back(v);
-    };
-    for (Index h = 0; h < mesh.num_hexes(); ++h) {
-      if (!(sj[h] < kQuestionableSJ || is_degenerate(sj[h]))) continue;
-      add(h);
-      if (round > 1)
-        for (Index v : mesh.hexes[h])
-          for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) add(inc.ids[k]);
-    }
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-    const std::vector<Vec3> points = mesh.points;
     const BoundarySurface saved = surface;
-    const std::size_t n = surface.loosen(mesh, candidates, band);
+    std::size_t n = 0;
+    for (int reach = round > 1 ? 1 : 0; n == 0 && reach <= kMaxReach; ++reach) {
+      candidates = release_candidates(mesh, inc, surface, sj, reach);
+      n = surface.loosen(mesh, candidates, band);
+    }
+    const std::vector<Vec3> points = mesh.points;
     if (n == 0) break;
     fmt::print("boundary: {} vertices of hexes below 0.2 released into a band of {:.3g} about their surface; "
                "optimising again\n", n, band);

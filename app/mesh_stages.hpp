@@ -48,8 +48,9 @@ ProgressCallback progress_printer(std::FILE* out);
 /// reason; shape; worst). Returns the JSON facts ("untangle", "shape", "worst").
 nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options);
 
-/// After a first run_optimisation() with `surface`: up to three rounds that release the
-/// boundary vertices of the hexes still below 0.2 into a band of half-width `band` (world
+/// After a first run_optimisation() with `surface`: up to five rounds that release the
+/// boundary vertices of the hexes still below 0.2 (or with a jacobian ratio below 0.1), and of
+/// the hexes up to 3 vertex rings around them, into a band of half-width `band` (world
 /// units) about their surface (BoundarySurface::loosen) and optimise again within 3 hex rings
 /// of those hexes. Returns each round's JSON facts (with "released": vertices released).
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& options);

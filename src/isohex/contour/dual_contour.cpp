@@ -21,6 +21,9 @@ namespace {
 
 // Fraction of the cell size kept between a dual vertex (before projection) and its cell's faces.
 constexpr double kClampMargin = 0.05;
+// Dual vertices of neighbouring cells closer than this (in cells) are placed again, away from
+// their cells' faces.
+constexpr double kNearVertices = 0.01;
 
 
 using Clock = std::chrono::steady_clock;
@@ -54,6 +57,13 @@ bool project_within_faces(const LevelSet& s, Vec3& p, unsigned fixed, double max
   return false;
 }
 
+// Distance from p (in or near the cell [lo, lo + h]^3) to the nearest face of the cell.
+double face_clearance(const Vec3& lo, double h, const Vec3& p) {
+  double d = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) d = std::min({d, std::abs(p[a] - lo[a]), std::abs(lo[a] + h - p[a])});
+  return d;
+}
+
 struct Placement {
   Vec3 point;
   std::int8_t place;
@@ -62,7 +72,7 @@ struct Placement {
 
 // The dual vertex of the inside component `comp` (corner bit set) of cell (i, j, k).
 Placement place_vertex(const Region& region, const SampledGrid& g, std::size_t i, std::size_t j, std::size_t k,
-                       std::uint8_t mask, std::uint8_t comp) {
+                       std::uint8_t mask, std::uint8_t comp, bool avoid_faces = false) {
   const double h = g.grid.h;
   const Vec3 lo = g.position(i, j, k);
   const Vec3 centre = lo + Vec3::Constant(0.5 * h);
@@ -219,25 +229,43 @@ Placement place_vertex(const Region& region, const SampledGrid& g, std::size_t i
   }
   Vec3 y = x;
   const LevelSet& ls = region.surfaces[static_cast<std::size_t>(surface)];
-  if (ls.project(y, h)) return {y, static_cast<std::int8_t>(surface), false};
-  // Fall back to the zero on the segment from the clamped minimiser, strictly inside the cell,
-  // to the nearest corner on the other side: a point inside the cell. (Not a crossing on the
-  // cell's edges: the cells around an edge would all take its crossing, one point for several
-  // dual vertices, collapsed quad edges and degenerate hexes that no optimiser can open.) A
-  // corner exactly at the isovalue is shared too and is not used.
+  const bool projected = ls.project(y, h);
+  // With avoid_faces (the vertex nearly coincides with a neighbour cell's), a projection next
+  // to a face of the cell is refused: where the surface touches a grid point, a cell edge or a
+  // face (a dimple tangent to it) the projections of the cells around it land on one point.
+  if (projected && (!avoid_faces || face_clearance(lo, h, y) >= margin)) return {y, static_cast<std::int8_t>(surface), false};
+  // Fall back to a zero on a segment from the clamped minimiser, strictly inside the cell, to a
+  // corner on the other side: a point inside the cell. (Not a crossing on the cell's edges: the
+  // cells around an edge would all take its crossing, one point for several dual vertices,
+  // collapsed quad edges and degenerate hexes that no optimiser can open.) A corner exactly at
+  // the isovalue is shared too and is not used. After a failed projection the nearest such
+  // corner; after one refused, the zero farthest from the cell's faces (if farther than it).
   const bool x_in = ls.level(x) > 0;
   double best_d = std::numeric_limits<double>::infinity();
-  Vec3 other = x;
+  double best_clearance = -1;
+  Vec3 other = x, best_z = x;
   for (int c = 0; c < 8; ++c) {
     const Vec3 q = lo + h * Vec3(c & 1, c >> 1 & 1, c >> 2 & 1);
     const double lq = ls.level(q);
     if ((x_in ? lq > 0 : !(lq > 0)) || std::abs(lq) <= ls.tolerance()) continue;
-    const double d = (q - x).squaredNorm();
-    if (d < best_d) {
-      best_d = d;
-      other = q;
+    if (!projected) {
+      const double d = (q - x).squaredNorm();
+      if (d < best_d) {
+        best_d = d;
+        other = q;
+      }
+      continue;
+    }
+    const Vec3 z = x_in ? ls.root(x, q) : ls.root(q, x);
+    const double clearance = face_clearance(lo, h, z);
+    if (std::abs(ls.level(z)) <= ls.tolerance() && clearance > best_clearance) {
+      best_clearance = clearance;
+      best_z = z;
     }
   }
+  if (projected)
+    return best_clearance > face_clearance(lo, h, y) ? Placement{best_z, static_cast<std::int8_t>(surface), true}
+                                                      : Placement{y, static_cast<std::int8_t>(surface), false};
   if (best_d < std::numeric_limits<double>::infinity()) {
     const Vec3 z = x_in ? ls.root(x, other) : ls.root(other, x);
     if (std::abs(ls.level(z)) <= ls.tolerance()) return {z, static_cast<std::int8_t>(surface), true};
@@ -315,6 +343,7 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   rep.degenerate_components = repaired.degenerate_components;
   rep.degenerate_points = repaired.degenerate;
   rep.zero_level_points = repaired.zero_level;
+  rep.pinch_points = repaired.pinch;
   {
     // Each flip's new state, walking back from the final one (a point can flip more than once).
     std::vector<std::uint8_t> state(repaired.edits.size());
@@ -366,28 +395,71 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   out.vertex_place.resize(first_vertex.back());
   // Vertex id of each cell's first component; cells without inside corners keep -1.
   std::vector<Index> cell_vertex(masks.size(), -1);
-  std::vector<std::size_t> slab_fallbacks(nz, 0);
+  std::vector<std::uint8_t> fallback(first_vertex.back(), 0);
+  const auto component_bits = [](const CellCase& cc, int comp) {
+    std::uint8_t bits = 0;
+    for (int c = 0; c < 8; ++c)
+      if (cc.component[c] == comp) bits |= static_cast<std::uint8_t>(1u << c);
+    return bits;
+  };
+  const auto place = [&](std::size_t i, std::size_t j, std::size_t k, int comp, std::size_t v, bool avoid_faces) {
+    const std::uint8_t m = masks[i + nx * (j + ny * k)];
+    const Placement pl = place_vertex(region, g, i, j, k, m, component_bits(cell_case(m), comp), avoid_faces);
+    mesh.points[v] = pl.point;
+    out.vertex_place[v] = pl.place;
+    fallback[v] = pl.fallback;
+  };
   for_slabs(nz, [&](std::size_t k) {
     std::size_t v = first_vertex[k];
     for (std::size_t j = 0; j < ny; ++j)
       for (std::size_t i = 0; i < nx; ++i) {
         const std::size_t cell = i + nx * (j + ny * k);
-        const std::uint8_t m = masks[cell];
-        if (m == 0) continue;
+        if (masks[cell] == 0) continue;
         cell_vertex[cell] = static_cast<Index>(v);
-        const CellCase& cc = cell_case(m);
-        for (int comp = 0; comp < cc.num_components; ++comp, ++v) {
-          std::uint8_t bits = 0;
-          for (int c = 0; c < 8; ++c)
-            if (cc.component[c] == comp) bits |= static_cast<std::uint8_t>(1u << c);
-          const Placement pl = place_vertex(region, g, i, j, k, m, bits);
-          mesh.points[v] = pl.point;
-          out.vertex_place[v] = pl.place;
-          slab_fallbacks[k] += pl.fallback;
+        for (int comp = 0; comp < cell_case(masks[cell]).num_components; ++comp, ++v) place(i, j, k, comp, v, false);
+      }
+  });
+  // Surface vertices of neighbouring cells (or of one cell's components) that nearly coincide
+  // are placed again, away from their cells' faces: one point for two dual vertices makes a
+  // collapsed edge that no optimiser opens (the MR head at 40, h 4: a dimple tangent to a cell
+  // edge). Found first, then moved, so the result does not depend on the order.
+  std::vector<std::uint8_t> near(first_vertex.back(), 0);
+  const double near2 = kNearVertices * h * kNearVertices * h;
+  for_slabs(nz, [&](std::size_t k) {
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        const std::size_t cell = i + nx * (j + ny * k);
+        if (masks[cell] == 0 || masks[cell] == 0xff) continue;
+        const auto n = static_cast<std::size_t>(cell_case(masks[cell]).num_components);
+        for (std::size_t v = static_cast<std::size_t>(cell_vertex[cell]); v < static_cast<std::size_t>(cell_vertex[cell]) + n; ++v) {
+          if (out.vertex_place[v] < 0) continue;
+          for (std::size_t c = 0; c < 27 && !near[v]; ++c) {
+            const std::size_t ni = i + c % 3, nj = j + c / 3 % 3, nk = k + c / 9;  // offsets -1..1, shifted by 1
+            if (ni < 1 || nj < 1 || nk < 1 || ni > nx || nj > ny || nk > nz) continue;
+            const std::size_t other = ni - 1 + nx * (nj - 1 + ny * (nk - 1));
+            if (masks[other] == 0) continue;
+            const auto u0 = static_cast<std::size_t>(cell_vertex[other]);
+            for (std::size_t u = u0; u < u0 + static_cast<std::size_t>(cell_case(masks[other]).num_components); ++u)
+              if (u != v && (mesh.points[u] - mesh.points[v]).squaredNorm() < near2) near[v] = 1;
+          }
         }
       }
   });
-  for (std::size_t f : slab_fallbacks) rep.projection_fallbacks += f;
+  for_slabs(nz, [&](std::size_t k) {
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        const std::size_t cell = i + nx * (j + ny * k);
+        if (masks[cell] == 0) continue;
+        for (int comp = 0; comp < cell_case(masks[cell]).num_components; ++comp) {
+          const std::size_t v = static_cast<std::size_t>(cell_vertex[cell]) + static_cast<std::size_t>(comp);
+          if (near[v]) place(i, j, k, comp, v, true);
+        }
+      }
+  });
+  for (std::size_t v = 0; v < near.size(); ++v) {
+    rep.projection_fallbacks += fallback[v];
+    rep.separated_vertices += near[v];
+  }
   for (std::int8_t p : out.vertex_place) {
     rep.box_vertices += p == kBoxVertex;
     rep.surface_vertices += p >= 0;

@@ -64,6 +64,9 @@ enum class RepairKind : std::uint8_t {
               ///< volume, and of zero area for fewer than 4 samples, which would give collapsed quads
   zero_level, ///< a fill of a sample at L == 0 on a real surface on which dual contouring would put
               ///< several vertices: a simple point, topology kept (fill_zero_level_samples)
+  pinch,      ///< a fill where the sides touch with zero width at a sample at L == 0 that several
+              ///< cells' dual vertices would share (fill_shared_pins): may change the topology
+              ///< by connections of zero width (two cavities touching at one point come apart)
 };
 
 /// Where a mesh vertex lies (ExtractResult::vertex_place); values ≥ 0 name a surface of the
@@ -91,6 +94,7 @@ struct ExtractReport {
   std::size_t degenerate_components = 0;  ///< zero-volume cavities filled (all samples at L == 0)
   std::size_t degenerate_points = 0;      ///< of the filled, their samples
   std::size_t zero_level_points = 0;      ///< of the filled, samples at L == 0 made inside (simple; topology kept)
+  std::size_t pinch_points = 0;           ///< of the filled, pinches of zero width made inside (RepairKind::pinch)
   /// Every flip of the repair in the order made: grid point (i, j, k), its state after the
   /// flip (true = made inside), and its kind. Applied to the samples, the simple, zero_level and
   /// relocated ones keep marching cubes' topology and all of them give the mesh's topology; the
@@ -111,7 +115,8 @@ struct ExtractReport {
   std::size_t split_cells = 0;         ///< cells with more than one dual vertex
   std::size_t surface_vertices = 0;    ///< vertices on a surface of the region
   std::size_t box_vertices = 0;        ///< vertices on the domain box (not checked against a surface)
-  std::size_t projection_fallbacks = 0;  ///< projection failed; the nearest crossing was used
+  std::size_t projection_fallbacks = 0;  ///< projection failed (or refused); a zero in the cell or the nearest crossing used
+  std::size_t separated_vertices = 0;    ///< surface vertices placed again: within 0.01 cells of a neighbour cell's
   double time_sample = 0, time_repair = 0, time_components = 0, time_vertices = 0, time_hexes = 0;
 };
 

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -241,6 +242,28 @@ bool pinned_to(const SampledGrid& g, std::size_t cell, std::size_t q) {
   return any;
 }
 
+// True when the only zeros of cell `cell` are at its inside corner q (L == 0): every edge from
+// an inside corner to an outside one ends at a carved sample (L > 0, no crossing there), and q
+// is the only inside corner at L <= 0. dual_contour.cpp then takes the zeros on the inside
+// corners' edges, which are all q.
+bool loose_pinned_to(const SampledGrid& g, std::size_t cell, std::size_t q) {
+  const std::uint8_t m = g.cell_mask_at(cell);
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  bool any = false;
+  for (int c = 0; c < 8; ++c) {
+    const std::size_t p = cell + (c & 1) + dy * (c >> 1 & 1) + dz * (c >> 2 & 1);
+    if (!(m >> c & 1)) continue;
+    if (!(g.level[p] > 0) && p != q) return false;
+    for (int a = 0; a < 3; ++a) {
+      const int d = c ^ (1 << a);
+      if (m >> d & 1) continue;
+      if (!(g.level[cell + (d & 1) + dy * (d >> 1 & 1) + dz * (d >> 2 & 1)] > 0)) return false;
+      any = true;
+    }
+  }
+  return any;
+}
+
 // More than one cell around outside sample q at L == 0 has its dual vertex on q.
 bool shared_pin(const SampledGrid& g, std::size_t q) {
   int n = 0;
@@ -274,6 +297,32 @@ std::size_t fill_zero_level_samples(SampledGrid& g, RepairCounts& counts) {
   }
   counts.filled += total;
   counts.zero_level += total;
+  return total;
+}
+
+std::size_t fill_shared_pins(SampledGrid& g, RepairCounts& counts) {
+  std::size_t total = 0;
+  auto fill = [&](std::size_t p) {
+    g.inside[p] = 1;
+    counts.edits.push_back({p, RepairKind::pinch});
+    ++total;
+  };
+  for (std::size_t p : zero_level_outside(g))
+    if (!g.inside[p] && shared_pin(g, p)) fill(p);
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  for (std::size_t q : zero_level_samples(g, 1)) {
+    std::array<std::size_t, 8> pinned{};
+    int n = 0;
+    for (std::size_t cell : cells_around(g, q))
+      if (loose_pinned_to(g, cell, q)) pinned[static_cast<std::size_t>(n++)] = cell;
+    if (n < 2) continue;
+    for (int i = 0; i < n; ++i)
+      for (int c = 0; c < 8; ++c) {
+        const std::size_t p = pinned[static_cast<std::size_t>(i)] + (c & 1) + dy * (c >> 1 & 1) + dz * (c >> 2 & 1);
+        if (!g.inside[p]) fill(p);
+      }
+  }
+  counts.pinch += total;
   return total;
 }
 

@@ -10,13 +10,15 @@
 
 namespace isohex::contour {
 
-std::vector<std::size_t> zero_level_outside(const SampledGrid& g) {
+std::vector<std::size_t> zero_level_outside(const SampledGrid& g) { return zero_level_samples(g, 0); }
+
+std::vector<std::size_t> zero_level_samples(const SampledGrid& g, std::uint8_t side) {
   const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
   std::vector<std::vector<std::size_t>> found(g.padded[2]);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(1, g.padded[2] - 1), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t k = r.begin(); k != r.end(); ++k)
       for (std::size_t p = dz * k + dy, end = dz * (k + 1) - dy; p < end; ++p)
-        if (!g.inside[p] && g.on_isosurface(p)) found[k].push_back(p);
+        if (g.inside[p] == side && g.on_isosurface(p)) found[k].push_back(p);
   });
   std::vector<std::size_t> all;
   for (const auto& slab : found) all.insert(all.end(), slab.begin(), slab.end());

@@ -156,7 +156,10 @@ class CavityMove {
     double best = std::numeric_limits<double>::infinity();
     for (int c = 0; c < 8; ++c) {
       const std::size_t p = cell + static_cast<std::size_t>((c & 1) + dy_ * (c >> 1 & 1) + dz_ * (c >> 2 & 1));
-      if (g_.inside[p] || g_.is_padding(p % g_.padded[0], p / g_.padded[0] % g_.padded[1], p / (g_.padded[0] * g_.padded[1])) ||
+      // A cavity at L == 0 has no volume: it is filled (fill_degenerate_cavities), not moved
+      // to a sample inside the field, whose cavity no surface bounds.
+      if (g_.inside[p] || g_.on_isosurface(p) ||
+          g_.is_padding(p % g_.padded[0], p / g_.padded[0] % g_.padded[1], p / (g_.padded[0] * g_.padded[1])) ||
           !all_inside(p, 2, kNone))
         continue;
       const std::size_t pi = p % g_.padded[0], pj = p / g_.padded[0] % g_.padded[1], pk = p / (g_.padded[0] * g_.padded[1]);
@@ -245,6 +248,10 @@ RepairCounts repair_manifold(SampledGrid& g) {
   // Where no short sequence exists: cavity moves, prepared sequences, the deep search, the
   // first that does anything; then short sequences again around what changed.
   while (!cells.empty()) {
+    // The simple flips can enclose a sample at L == 0 as a cavity of its own.
+    const std::size_t before_fill = counts.edits.size();
+    if (fill_degenerate_cavities(g, counts) > 0) cells = still_non_manifold(g, std::move(cells), counts, before_fill);
+    if (cells.empty()) break;
     CavityMove cavity(g);
     auto move_cavity = [&](std::size_t cell, std::size_t& a, std::size_t& b) {
       return cavity.repair(cell) && (a = cavity.from(), b = cavity.to(), true);
@@ -258,7 +265,8 @@ RepairCounts repair_manifold(SampledGrid& g) {
   const std::size_t before_zero = counts.edits.size();
   fill_zero_level_samples(g, counts);
   cells = still_non_manifold(g, std::move(cells), counts, before_zero);
-  const std::size_t simple_carved = counts.carved, simple_filled = counts.filled;
+  const std::size_t simple_carved = counts.carved;
+  std::size_t simple_filled = counts.filled;
   const std::size_t before_carving = counts.edits.size();
   counts.carved = repair_phase(g, 0, cells, counts, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
     const std::uint8_t cand = carve_candidates(m);
@@ -275,9 +283,16 @@ RepairCounts repair_manifold(SampledGrid& g) {
     return manifold_carve(m, level, allowed);
   });
   cells = still_non_manifold(g, std::move(cells), counts, before_carving);
-  counts.filled = repair_phase(g, 1, cells, counts, [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
+  auto fill = [&](std::uint8_t m, std::size_t i, std::size_t j, std::size_t k) {
     return manifold_fill(m, g.padding_mask(i, j, k));
-  });
+  };
+  counts.filled = repair_phase(g, 1, cells, counts, fill);
+  // Samples at L == 0 that still pin several cells' dual vertices are filled anyway, and what
+  // that makes non-manifold is filled too; fills only, so this ends.
+  for (std::size_t from = counts.edits.size(); fill_shared_pins(g, counts) > 0; from = counts.edits.size()) {
+    simple_filled += counts.edits.size() - from;
+    counts.filled += repair_phase(g, 1, still_non_manifold(g, {}, counts, from), counts, fill);
+  }
   counts.forced = counts.carved + counts.filled;
   counts.carved += simple_carved;
   counts.filled += simple_filled;

@@ -26,6 +26,8 @@ bool near_surface(const SampledGrid& g, std::size_t p);
 /// The outside samples exactly at L == 0 (SampledGrid::on_isosurface), in grid order; found per
 /// z-slab in parallel. The candidates of both fills of samples at the isovalue.
 std::vector<std::size_t> zero_level_outside(const SampledGrid& g);
+/// The same for the samples on `side` (0 outside, 1 inside: samples at L == 0 that a repair filled).
+std::vector<std::size_t> zero_level_samples(const SampledGrid& g, std::uint8_t side);
 
 /// The non-manifold cells among `cells` and among the cells around the points flipped since
 /// edit `from`, in grid order: all there are, if `cells` were all before those flips
@@ -39,6 +41,17 @@ std::vector<std::size_t> still_non_manifold(const SampledGrid& g, std::vector<st
 /// until one flips nothing, or one round of prepared sequences or of the deep search. That
 /// number falls with every sequence, so this ends; sequential, in cell order, so it is
 /// deterministic. Updates `cells` to the non-manifold cells left and returns the number of flips.
+/// Where the dual vertices of several cells would go onto one sample at L == 0, makes inside
+/// what puts them there, in grid order and whatever that does to the topology (there the two
+/// sides touch with zero width; one point for several dual vertices is collapsed quads and
+/// degenerate hexes): an outside sample at L == 0 on which more than one cell has all its
+/// crossings (those fill_zero_level_samples leaves because the flip is not simple or makes a
+/// cell non-manifold), and, around an inside sample at L == 0 on which more than one cell has
+/// its only zeros (every outside corner of those cells carved at L > 0), those carved corners.
+/// The caller then repairs the cells this makes non-manifold. Returns the samples filled
+/// (kind pinch; counted in `pinch`, not yet in `filled`).
+std::size_t fill_shared_pins(SampledGrid& g, RepairCounts& counts);
+
 enum class Search { short_, prepared, deep };
 std::size_t simple_phase(SampledGrid& g, RepairCounts& counts, Search mode, std::vector<std::size_t>& cells);
 

@@ -66,6 +66,7 @@ struct RepairCounts {
   std::size_t degenerate = 0;             ///< of the filled, points of zero-volume cavities
   std::size_t degenerate_components = 0;  ///< zero-volume cavities filled
   std::size_t zero_level = 0;  ///< of the filled, samples at L == 0 on a real surface (fill_zero_level_samples)
+  std::size_t pinch = 0;       ///< of the filled, pinches of zero width (fill_shared_pins)
   struct Edit {
     std::size_t point;  ///< padded index
     RepairKind kind;

@@ -217,7 +217,9 @@ struct WorstOptions {
   double ratio_floor = 0.2;
   /// The max–min moves also raise the Bernstein coefficients of det J over each hex's largest
   /// (a lower bound of its jacobian ratio, weighted 2: a ratio of 0.1 counts as a scaled
-  /// Jacobian of 0.2), and the worst hexes are chosen by the lower of the two.
+  /// Jacobian of 0.2), and the worst hexes are chosen by the lower of the two. Where a ratio
+  /// term is the smallest and cannot rise, a second phase raises the scaled-Jacobian frames
+  /// alone with the ratio terms held at their smallest (LP constraints).
   bool ratio_terms = true;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;

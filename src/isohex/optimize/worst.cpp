@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace isohex {
@@ -163,6 +164,12 @@ double lowest(const std::vector<opt::Affine>& f) {
 // if the smallest of those frame values rises, Verdict's minimum around v does not fall, no
 // valid hex is inverted and no more hexes around v fall below 0.2; so the mesh minimum never
 // falls. A sliding vertex steps in its tangent plane and is put back on its surface.
+//
+// With the ratio terms, the smallest value is often a ratio term that no move of v alone can
+// raise (a cluster of pillow hexes with ratios 0.07-0.08 at a convex tip of cthead h 4), and a
+// scaled Jacobian below 0.2 beside it was left as it was. A second phase then raises the
+// scaled-Jacobian frames alone with the ratio terms held as constraints: none falls below the
+// smallest of them now, and the certified ratio around v does not fall either.
 bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector<Vec3>& start,
                  const BoundarySurface* surface, const WorstOptions& options) {
   const Vec3 x0 = mesh.points[v];
@@ -176,46 +183,78 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
   if (!(len > 0)) return false;
   const bool slides = surface && surface->role(v) == BoundarySurface::Role::slides;
   Vec3 x = x0;
-  double box = options.step * len;
   bool moved = false;
-  for (int model = 0; model < options.models; ++model) {
-    std::vector<opt::Affine> f = frame_values(mesh, inc, v, x, false, ratio);
-    const double now = lowest(f);
-    // Frames at the target are good enough: no move there, and the model seeks no more (a
-    // constant frame at the target caps the LP's bound), so the max–min step does not flatten
-    // the shape of hexes that need no help.
-    if (!(now < options.target)) break;
-    // Tangential steps of a sliding vertex: the LP's unknowns are coordinates in the tangent
-    // plane (the third has no effect and stays in the box).
-    Vec3 n = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
-    if (slides) {
-      if (!surface->tangent_normal(v, x, n)) break;
-      t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
-      t2 = n.cross(t1);
-      for (opt::Affine& a : f) a.a = Vec3(a.a.dot(t1), a.a.dot(t2), 0.0);
+  // Phase 2's constraint level: the smallest ratio term where it starts (NaN in phase 1).
+  double held_ratio = std::numeric_limits<double>::quiet_NaN();
+  // The terms of the model at y: the frames (and in phase 1 the ratio terms) to raise, as
+  // weight-1 terms; in phase 2 the ratio terms as constraints, offset by held_ratio and
+  // weighted almost 0 (f >= s·w is then f >= held_ratio, nearly).
+  const auto terms = [&](const Vec3& y, bool value_only, std::vector<double>& w, double& now) {
+    std::vector<opt::Affine> f = frame_values(mesh, inc, v, y, value_only, std::isnan(held_ratio) ? ratio : nullptr);
+    now = lowest(f);
+    w.assign(f.size(), 1.0);
+    if (!std::isnan(held_ratio)) {
+      std::vector<opt::Affine> r;
+      ratio_terms(mesh, inc, v, y, value_only, norms, r);
+      for (opt::Affine& a : r) a.b -= held_ratio, f.push_back(a), w.push_back(1e-6);
     }
-    f.push_back({Vec3::Zero(), options.target});
-    const std::vector<double> w(f.size(), 1.0);
-    bool gained = false;
-    for (int trial = 0; trial < options.trials && !gained; ++trial, box *= 0.5) {
-      const opt::MaxMin r = opt::max_min_affine(f, w, box);
-      if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model: a max–min point
-      Vec3 y = slides ? Vec3(x + r.d[0] * t1 + r.d[1] * t2) : Vec3(x + r.d);
-      if (surface && !surface->put_back(v, y, n, len)) continue;  // off the surface (or band): refused
-      bool valid = false;
-      int below = 0;
-      double ratio_y = 1;
-      // A negative local minimum may rise while a valid neighbour is inverted on the way;
-      // raising one hex by bending several others below 0.2 is no gain.
-      const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y);
-      if (!valid || below > below0 || q < m0 || ratio_y < ratio_floor ||
-          !(lowest(frame_values(mesh, inc, v, y, true, ratio)) > now + 1e-9))
-        continue;
-      x = y;
-      gained = moved = true;
+    return f;
+  };
+  for (int phase = 1; phase <= (options.ratio_terms ? 2 : 1); ++phase) {
+    if (phase == 2) {
+      std::vector<opt::Affine> r;
+      ratio_terms(mesh, inc, v, x, true, norms, r);
+      if (r.empty()) break;
+      held_ratio = lowest(r);
     }
-    if (!gained) break;
-    box = std::min(4 * box, options.step * len);  // the box that worked, doubled (the loop halved it once more)
+    double box = options.step * len;
+    for (int model = 0; model < options.models; ++model) {
+      std::vector<double> w;
+      double now = 0;
+      std::vector<opt::Affine> f = terms(x, false, w, now);
+      // Frames at the target are good enough: no move there, and the model seeks no more (a
+      // constant frame at the target caps the LP's bound), so the max–min step does not flatten
+      // the shape of hexes that need no help.
+      if (!(now < options.target)) break;
+      // Tangential steps of a sliding vertex: the LP's unknowns are coordinates in the tangent
+      // plane (the third has no effect and stays in the box).
+      Vec3 n = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
+      if (slides) {
+        if (!surface->tangent_normal(v, x, n)) break;
+        t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+        t2 = n.cross(t1);
+        for (opt::Affine& a : f) a.a = Vec3(a.a.dot(t1), a.a.dot(t2), 0.0);
+      }
+      f.push_back({Vec3::Zero(), options.target});
+      w.push_back(1.0);
+      bool gained = false;
+      for (int trial = 0; trial < options.trials && !gained; ++trial, box *= 0.5) {
+        const opt::MaxMin r = opt::max_min_affine(f, w, box);
+        if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model: a max–min point
+        Vec3 y = slides ? Vec3(x + r.d[0] * t1 + r.d[1] * t2) : Vec3(x + r.d);
+        if (surface && !surface->put_back(v, y, n, len)) continue;  // off the surface (or band): refused
+        bool valid = false;
+        int below = 0;
+        double ratio_y = 1;
+        // A negative local minimum may rise while a valid neighbour is inverted on the way;
+        // raising one hex by bending several others below 0.2 is no gain.
+        const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y);
+        if (!valid || below > below0 || q < m0 || ratio_y < ratio_floor) continue;
+        std::vector<double> wy;
+        double now_y = 0;
+        const std::vector<opt::Affine> fy = terms(y, true, wy, now_y);
+        if (!(now_y > now + 1e-9)) continue;
+        if (phase == 2) {  // the ratio terms held, and the certified ratio around v too
+          bool held = ratio_y >= ratio0;
+          for (std::size_t i = 0; i < fy.size(); ++i) held = held && (wy[i] == 1.0 || fy[i].b >= 0);
+          if (!held) continue;
+        }
+        x = y;
+        gained = moved = true;
+      }
+      if (!gained) break;
+      box = std::min(4 * box, options.step * len);  // the box that worked, doubled (the loop halved it once more)
+    }
   }
   if (!moved) return false;
   mesh.points[v] = x;
