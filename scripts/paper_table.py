@@ -114,7 +114,7 @@ def main():
     ap.add_argument("--cli", default="build/bin/isohex")
     ap.add_argument("--data", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data"))
     ap.add_argument("--out", default=os.path.join(os.path.dirname(__file__), "..", "docs", "paper-table.md"))
-    ap.add_argument("--only", default="", help="comma-separated case names (prefixes)")
+    ap.add_argument("--only", default="", help="case names (prefixes), separated by ';' (names contain commas)")
     ap.add_argument("--other-sizes", action="store_true", help="also other cell sizes of the same scans")
     args = ap.parse_args()
     if not os.path.isdir(os.path.join(args.data, "volumes")):
@@ -125,7 +125,7 @@ def main():
              "max edge ratio | volume excess | outside the domain | time (s) | paper: hexes | paper: < 0.2 |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, paper, mesh_args, prep in cases(args.data, tmp) + (other_sizes(args.data) if args.other_sizes else []):
-        if args.only and not any(name.startswith(o) for o in args.only.split(",")):
+        if args.only and not any(name.startswith(o) for o in args.only.split(";")):
             continue
         if prep:
             subprocess.run([args.cli] + prep, check=True, capture_output=True)
