@@ -212,7 +212,7 @@ void run(const Args& a) {
   nlohmann::json pillowing, optimisation;
   if (!a.no_pillow) {
     t = Clock::now();
-    pillowing = pillow_stage(out.mesh, out.vertex_place, terminal);
+    pillowing = pillow_stage(out.mesh, out.vertex_place, region.domain, terminal);
     rows.push_back(stage_row("pillowing", out.mesh, seconds_since(t)));
     rows.back().extra = pillowing;
   }

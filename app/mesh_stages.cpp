@@ -25,16 +25,21 @@ StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds)
   return r;
 }
 
-nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, bool terminal) {
+nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const Aabb& domain, bool terminal) {
   if (terminal) fmt::print("  pillowing...\n"), std::fflush(stdout);
-  PillowResult p = pillow_boundary(mesh);
-  fmt::print("pillowing: {} new hexes (one per boundary quad), {} new vertices, min SJ of the new hexes {:.4g}\n",
-             p.interface_quads, p.mesh.num_vertices() - mesh.num_vertices(), p.min_new_scaled_jacobian);
+  PillowOptions po;
+  po.domain_lo = domain.lo;
+  po.domain_hi = domain.hi;
+  PillowResult p = pillow_boundary(mesh, -1, po);
+  fmt::print("pillowing: {} new hexes (one per boundary quad), {} new vertices ({} clamped into the domain), min SJ "
+             "of the new hexes {:.4g}\n",
+             p.interface_quads, p.mesh.num_vertices() - mesh.num_vertices(), p.clamped_vertices, p.min_new_scaled_jacobian);
   // Old vertices keep their ids (the boundary among them); the copies are interior.
   vertex_place.resize(static_cast<std::size_t>(p.mesh.num_vertices()), contour::kInteriorVertex);
   nlohmann::json j = {{"new_hexes", p.interface_quads},
                       {"new_vertices", p.mesh.num_vertices() - mesh.num_vertices()},
                       {"pinch_copies", p.pinch_copies},
+                      {"clamped_vertices", p.clamped_vertices},
                       {"min_new_sj", p.min_new_scaled_jacobian}};
   mesh = std::move(p.mesh);
   return j;

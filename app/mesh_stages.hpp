@@ -33,7 +33,8 @@ StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds)
 /// Boundary pillowing: one sheet of hexes inside the whole boundary, the surface kept as it is.
 /// `vertex_place` (one entry per vertex, see contour::ExtractResult) grows with the new
 /// vertices, which are interior. Returns the JSON facts of the stage.
-nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, bool terminal);
+/// Pillows the boundary, the new vertices kept in `domain` (the sampled box).
+nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const Aabb& domain, bool terminal);
 
 /// `isohex mesh --refine-boundary TOL`: contour::refine_boundary() on the extraction, its line
 /// printed; returns its JSON facts and sets `seconds`.

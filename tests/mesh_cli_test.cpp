@@ -164,6 +164,24 @@ TEST(MeshCli, BoundaryRefinementKeepsTheMeshValidAndOnTheSurface) {
   EXPECT_NE(run_cli("mesh --shape " + shape + " --resolution 8 --refine-boundary -1 -o " + q(dir / "bad.vtu"), &out), 0);
 }
 
+// Pillowing alone (no surface smoothing, no optimisation) on headsq, whose skull the volume's
+// box cuts: the copies of rim vertices went across the box (46 vertices outside the domain);
+// they are clamped into it, and no vertex is outside.
+TEST(MeshCli, PillowingKeepsTheNewVerticesInTheDomain) {
+  ISOHEX_REQUIRE_SHARED_DATA();
+  const auto dir = scratch_dir();
+  std::string out;
+  ASSERT_LE(run_cli("mesh " + q(isohex::test::shared_data("volumes/headsq_64x64x93_int16le.raw")) +
+                        " --dims 64 64 93 --type i16 --spacing 3.2 3.2 1.5 --iso 1150 --cell-size 3.2 "
+                        "--no-surface-smoothing --no-smooth -o " + q(dir / "p.vtu") + " --json " + q(dir / "p.json"),
+                    &out),
+            1)
+      << out;
+  const auto j = nlohmann::json::parse(io::read_file(dir / "p.json"));
+  EXPECT_GT(j["pillowing"]["clamped_vertices"].get<int>(), 0);
+  EXPECT_EQ(j["outside_domain_vertices"].get<int>(), 0);
+}
+
 // --surface-band on the CT head's bone (headsq at 1150, h 3.2), where one-voxel knife edges
 // leave hexes below 0.2 with every boundary vertex on the isosurface: released into a band of
 // 0.3 cells they become fewer, and every released vertex is within the band (measured again

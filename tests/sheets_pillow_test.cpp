@@ -312,6 +312,21 @@ TEST(Pillow, OneBlockGetsAnEnclosingSheet) {
   EXPECT_THROW(pillow_boundary(m, 9), Error);
 }
 
+// A copy placed outside PillowOptions' domain is clamped into it: on a 4 x 3 x 3 grid whose
+// x = 4 face's copies land at x = 3.75, a domain ending at x = 3.6 holds them at 3.6.
+TEST(Pillow, CopiesAreClampedIntoTheDomain) {
+  const HexMesh m = grid_mesh(4, 3, 3);
+  PillowOptions opt;
+  opt.domain_hi = Vec3(3.6, 10, 10);
+  const PillowResult r = pillow_boundary(m, -1, opt);
+  EXPECT_EQ(r.clamped_vertices, 4u * 4u);  // the copies of the x = 4 face's vertices
+  for (std::size_t v = m.points.size(); v < r.mesh.points.size(); ++v) EXPECT_LE(r.mesh.points[v].x(), 3.6);
+  EXPECT_TRUE(same_surface(m, r.mesh));
+  EXPECT_TRUE(validate(r.mesh).valid());
+  EXPECT_GT(r.min_new_scaled_jacobian, 0);
+  EXPECT_EQ(pillow_boundary(m).clamped_vertices, 0u);
+}
+
 TEST(Pillow, BadInputIsRefusedWithAClearMessage) {
   const HexMesh m = grid_mesh(2, 2, 2);
   auto message = [](auto&& f) {

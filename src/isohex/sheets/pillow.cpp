@@ -131,11 +131,16 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
   out = mesh;
   const Index nv0 = mesh.num_vertices(), nh0 = mesh.num_hexes();
   std::vector<const detail::SplitVertex*> copies;  // by new id - nv0
+  std::vector<Vec3> displacement;                  // by new id - nv0, clamped into the domain
   std::vector<Index> changed;
   for (const detail::SplitVertex& sv : split.vertices) {
     if (sv.id == sv.original) continue;
     copies.push_back(&sv);
-    out.points.push_back(mesh.points[sv.original] + sv.displacement);
+    const Vec3& x = mesh.points[sv.original];
+    const Vec3 y = (x + sv.displacement).cwiseMax(options.domain_lo).cwiseMin(options.domain_hi);
+    r.clamped_vertices += y != x + sv.displacement;
+    displacement.push_back(y - x);
+    out.points.push_back(y);
     r.copy_of.push_back(sv.original);
     r.outside_copies += !sv.shrink_side;
     for (Index h : sv.hexes) {
@@ -187,7 +192,7 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
     for (std::size_t c = 0; c < copies.size(); ++c)
       if (halve[c]) {
         scale[c] *= 0.5;
-        out.points[nv0 + c] = mesh.points[copies[c]->original] + scale[c] * copies[c]->displacement;
+        out.points[nv0 + c] = mesh.points[copies[c]->original] + scale[c] * displacement[c];
       }
   }
   r.reduced_vertices =
@@ -204,14 +209,18 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
 }
 
 PillowResult pillow_boundary(const HexMesh& mesh, Index block, double offset) {
+  PillowOptions opt;
+  opt.offset = offset;
+  return pillow_boundary(mesh, block, opt);
+}
+
+PillowResult pillow_boundary(const HexMesh& mesh, Index block, PillowOptions opt) {
   std::vector<std::uint8_t> in(mesh.hexes.size(), 1);
   if (block >= 0) {
     for (Index h = 0; h < mesh.num_hexes(); ++h) in[h] = mesh.block(h) == block;
     if (std::find(in.begin(), in.end(), 1) == in.end())
       throw Error(fmt::format("pillow: block {} has no hexes", block));
   }
-  PillowOptions opt;
-  opt.offset = offset;
   opt.include_boundary = true;
   return pillow(mesh, in, opt);
 }

@@ -43,6 +43,7 @@
 #include "isohex/mesh/hex_mesh.hpp"
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,11 @@ struct PillowOptions {
   /// new hexes as degenerate (relative squared edge length below 2.2·10⁻¹⁵), which is worse
   /// for an untangler than a slightly inverted hex.
   int max_halvings = 12;
+  /// The box the new vertices must stay in (a volume's sampled domain): a copy placed outside
+  /// it is clamped into it first. Pillowing a solid cut by the box moved the copies of rim
+  /// vertices across it (headsq, no optimisation after: 46 vertices outside). Unbounded by default.
+  Vec3 domain_lo = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  Vec3 domain_hi = Vec3::Constant(std::numeric_limits<double>::infinity());
 };
 
 /// What pillow() did.
@@ -78,6 +84,7 @@ struct PillowResult {
   std::size_t inverted_new_hexes = 0;      ///< new hexes with scaled Jacobian <= 0 (only at folded vertices)
   std::size_t inverted_changed_hexes = 0;  ///< old hexes positive before, not after (ditto)
   std::size_t reduced_vertices = 0; ///< copies whose displacement had to be halved
+  std::size_t clamped_vertices = 0; ///< copies clamped into PillowOptions' domain box
   double min_new_scaled_jacobian = 1.0;  ///< over the new hexes
   /// Hexes added to / removed from the shrink set where a pinch had no valid placement
   /// (see pillow(); ascending).
@@ -96,7 +103,9 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
 
 /// Boundary sheets (§4.1.1): pillows the whole mesh (block < 0) or the hexes of one block,
 /// boundary quads included, so that every boundary component is captured by one new sheet.
+/// `options` as for pillow() (include_boundary is set here).
 PillowResult pillow_boundary(const HexMesh& mesh, Index block = -1, double offset = PillowOptions{}.offset);
+PillowResult pillow_boundary(const HexMesh& mesh, Index block, PillowOptions options);
 
 /// A shrink set from a CLI specification: `boundary` (every hex), `block:ID`,
 /// `region:EXPR` (hexes whose centroid is inside the implicit shape EXPR, see implicit.hpp)
