@@ -138,8 +138,9 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
     copies.push_back(&sv);
     const Vec3& x = mesh.points[sv.original];
     const Vec3 y = (x + sv.displacement).cwiseMax(options.domain_lo).cwiseMin(options.domain_hi);
-    r.clamped_vertices += y != x + sv.displacement;
-    displacement.push_back(y - x);
+    const bool clamped = y != x + sv.displacement;
+    r.clamped_vertices += clamped;
+    displacement.push_back(clamped ? Vec3(y - x) : sv.displacement);  // unclamped: the same bits as before
     out.points.push_back(y);
     r.copy_of.push_back(sv.original);
     r.outside_copies += !sv.shrink_side;
