@@ -168,31 +168,42 @@ std::vector<double> round_ranks(const HexMesh& mesh, RoundScore& score) {
   return sj;
 }
 
-// The boundary vertices of the hexes below 0.2 by `rank` and of the hexes within `reach`
-// vertex-sharing rings of them, sorted and unique.
-std::vector<Index> release_candidates(const HexMesh& mesh, const Incidence& inc, const BoundarySurface& surface,
-                                      const std::vector<double>& rank, int reach) {
-  std::vector<std::uint8_t> in(mesh.num_hexes(), 0);
-  std::vector<Index> ring;
-  for (Index h = 0; h < mesh.num_hexes(); ++h)
-    if (rank[h] < kQuestionableSJ || is_degenerate(rank[h])) in[h] = 1, ring.push_back(h);
-  for (int r = 0; r < reach; ++r) {
-    std::vector<Index> next;
-    for (Index h : ring)
-      for (Index v : mesh.hexes[h])
-        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
-          if (!in[inc.ids[k]]) in[inc.ids[k]] = 1, next.push_back(inc.ids[k]);
-    ring = std::move(next);
+// The hexes below 0.2 by `rank`, grown by vertex-sharing rings one at a time (a release
+// round widens its reach only when the nearer rings release nothing new).
+class ReleaseRings {
+ public:
+  ReleaseRings(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& rank)
+      : mesh_(mesh), inc_(inc), in_(mesh.num_hexes(), 0) {
+    for (Index h = 0; h < mesh.num_hexes(); ++h)
+      if (rank[h] < kQuestionableSJ || is_degenerate(rank[h])) in_[h] = 1, ring_.push_back(h);
+    members_ = ring_;
   }
-  std::vector<Index> candidates;
-  for (Index h = 0; h < mesh.num_hexes(); ++h)
-    if (in[h])
-      for (Index v : mesh.hexes[h])
-        if (surface.role(v) != BoundarySurface::Role::interior) candidates.push_back(v);
-  std::sort(candidates.begin(), candidates.end());
-  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-  return candidates;
-}
+  void grow() {
+    std::vector<Index> next;
+    for (Index h : ring_)
+      for (Index v : mesh_.hexes[h])
+        for (Index k = inc_.offsets[v]; k < inc_.offsets[v + 1]; ++k)
+          if (!in_[inc_.ids[k]]) in_[inc_.ids[k]] = 1, next.push_back(inc_.ids[k]);
+    members_.insert(members_.end(), next.begin(), next.end());
+    ring_ = std::move(next);
+  }
+  /// The boundary vertices of the hexes reached so far, sorted and unique.
+  [[nodiscard]] std::vector<Index> candidates(const BoundarySurface& surface) const {
+    std::vector<Index> c;
+    for (Index h : members_)
+      for (Index v : mesh_.hexes[h])
+        if (surface.role(v) != BoundarySurface::Role::interior) c.push_back(v);
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+    return c;
+  }
+
+ private:
+  const HexMesh& mesh_;
+  const Incidence& inc_;
+  std::vector<std::uint8_t> in_;
+  std::vector<Index> ring_, members_;
+};
 
 }  // namespace
 
@@ -223,9 +234,14 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
     std::vector<Index> candidates;
     const BoundarySurface saved = surface;
     std::size_t n = 0;
-    for (int reach = round > 1 ? 1 : 0; n == 0 && reach <= kMaxReach; ++reach) {
-      candidates = release_candidates(mesh, inc, surface, sj, reach);
-      n = surface.loosen(mesh, candidates, band);
+    ReleaseRings rings(mesh, inc, sj);
+    for (int reach = 0;; ++reach) {
+      if (reach >= (round > 1 ? 1 : 0)) {
+        candidates = rings.candidates(surface);
+        n = surface.loosen(mesh, candidates, band);
+        if (n > 0 || reach == kMaxReach) break;
+      }
+      rings.grow();
     }
     const std::vector<Vec3> points = mesh.points;
     if (n == 0) break;

@@ -10,10 +10,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <unordered_map>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
+#include <utility>
 
 namespace isohex::contour {
 
@@ -424,6 +425,7 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   // collapsed edge that no optimiser opens (the MR head at 40, h 4: a dimple tangent to a cell
   // edge). Found first, then moved, so the result does not depend on the order.
   std::vector<std::uint8_t> near(first_vertex.back(), 0);
+  std::vector<std::vector<std::pair<std::size_t, int>>> flagged(nz);  // per slab: (cell, component)
   const double near2 = kNearVertices * h * kNearVertices * h;
   for_slabs(nz, [&](std::size_t k) {
     for (std::size_t j = 0; j < ny; ++j)
@@ -442,19 +444,13 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
             for (std::size_t u = u0; u < u0 + static_cast<std::size_t>(cell_case(masks[other]).num_components); ++u)
               if (u != v && (mesh.points[u] - mesh.points[v]).squaredNorm() < near2) near[v] = 1;
           }
+          if (near[v]) flagged[k].emplace_back(cell, static_cast<int>(v - static_cast<std::size_t>(cell_vertex[cell])));
         }
       }
   });
   for_slabs(nz, [&](std::size_t k) {
-    for (std::size_t j = 0; j < ny; ++j)
-      for (std::size_t i = 0; i < nx; ++i) {
-        const std::size_t cell = i + nx * (j + ny * k);
-        if (masks[cell] == 0) continue;
-        for (int comp = 0; comp < cell_case(masks[cell]).num_components; ++comp) {
-          const std::size_t v = static_cast<std::size_t>(cell_vertex[cell]) + static_cast<std::size_t>(comp);
-          if (near[v]) place(i, j, k, comp, v, true);
-        }
-      }
+    for (const auto& [cell, comp] : flagged[k])
+      place(cell % nx, cell / nx % ny, k, comp, static_cast<std::size_t>(cell_vertex[cell]) + static_cast<std::size_t>(comp), true);
   });
   for (std::size_t v = 0; v < near.size(); ++v) {
     rep.projection_fallbacks += fallback[v];

@@ -83,7 +83,7 @@ class FlipSearch {
     best_score_ = std::numeric_limits<double>::infinity();
     for (int n = 2; n <= kPrepDepth && best_len_ == 0; ++n)
       for (int c = 0; c < 8; ++c) {
-        const std::size_t p = cell + (c & 1) + dy_ * (c >> 1 & 1) + dz_ * (c >> 2 & 1);
+        const std::size_t p = g_.corner_at(cell, c);
         if (!flippable(p)) continue;
         path_[static_cast<std::size_t>(n - 1)] = p;
         chain(n - 2, n, std::abs(static_cast<double>(g_.level[p])));
@@ -153,7 +153,7 @@ class FlipSearch {
   void search(const std::vector<std::size_t>& cells, int len, int delta, double score) {
     for (std::size_t cell : cells)
       for (int c = 0; c < 8; ++c) {
-        const std::size_t p = cell + (c & 1) + dy_ * (c >> 1 & 1) + dz_ * (c >> 2 & 1);
+        const std::size_t p = g_.corner_at(cell, c);
         if (!flippable(p) || std::find(path_.begin(), path_.begin() + len, p) != path_.begin() + len) continue;
         const double sc = score + std::abs(static_cast<double>(g_.level[p]));
         if (!(sc < best_score_)) continue;
@@ -226,14 +226,13 @@ namespace {
 // when it is at L == 0; with all of them at q the cell's dual vertex goes onto q.
 bool pinned_to(const SampledGrid& g, std::size_t cell, std::size_t q) {
   const std::uint8_t m = g.cell_mask_at(cell);
-  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
   bool any = false;
   for (int c = 0; c < 8; ++c) {
-    const std::size_t p = cell + (c & 1) + dy * (c >> 1 & 1) + dz * (c >> 2 & 1);
+    const std::size_t p = g.corner_at(cell, c);
     if (!(m >> c & 1) || !(g.level[p] > 0)) continue;
     for (int a = 0; a < 3; ++a) {
       const int d = c ^ (1 << a);
-      const std::size_t r = cell + (d & 1) + dy * (d >> 1 & 1) + dz * (d >> 2 & 1);
+      const std::size_t r = g.corner_at(cell, d);
       if ((m >> d & 1) || g.level[r] > 0) continue;  // no crossing on this edge
       if (r != q) return false;
       any = true;
@@ -248,16 +247,15 @@ bool pinned_to(const SampledGrid& g, std::size_t cell, std::size_t q) {
 // corners' edges, which are all q.
 bool loose_pinned_to(const SampledGrid& g, std::size_t cell, std::size_t q) {
   const std::uint8_t m = g.cell_mask_at(cell);
-  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
   bool any = false;
   for (int c = 0; c < 8; ++c) {
-    const std::size_t p = cell + (c & 1) + dy * (c >> 1 & 1) + dz * (c >> 2 & 1);
+    const std::size_t p = g.corner_at(cell, c);
     if (!(m >> c & 1)) continue;
     if (!(g.level[p] > 0) && p != q) return false;
     for (int a = 0; a < 3; ++a) {
       const int d = c ^ (1 << a);
       if (m >> d & 1) continue;
-      if (!(g.level[cell + (d & 1) + dy * (d >> 1 & 1) + dz * (d >> 2 & 1)] > 0)) return false;
+      if (!(g.level[g.corner_at(cell, d)] > 0)) return false;
       any = true;
     }
   }
@@ -309,7 +307,6 @@ std::size_t fill_shared_pins(SampledGrid& g, RepairCounts& counts) {
   };
   for (std::size_t p : zero_level_outside(g))
     if (!g.inside[p] && shared_pin(g, p)) fill(p);
-  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
   for (std::size_t q : zero_level_samples(g, 1)) {
     std::array<std::size_t, 8> pinned{};
     int n = 0;
@@ -318,7 +315,7 @@ std::size_t fill_shared_pins(SampledGrid& g, RepairCounts& counts) {
     if (n < 2) continue;
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < 8; ++c) {
-        const std::size_t p = pinned[static_cast<std::size_t>(i)] + (c & 1) + dy * (c >> 1 & 1) + dz * (c >> 2 & 1);
+        const std::size_t p = g.corner_at(pinned[static_cast<std::size_t>(i)], c);
         if (!g.inside[p]) fill(p);
       }
   }

@@ -71,7 +71,7 @@ std::size_t fill_degenerate_cavities(SampledGrid& g, RepairCounts& counts) {
     bool flat = true;
     for (std::size_t p : part) {
       bool whole = true;
-      for (int c = 0; c < 8 && whole; ++c) whole = zero_outside(p + (c & 1) + dy * (c >> 1 & 1) + dz * (c >> 2 & 1));
+      for (int c = 0; c < 8 && whole; ++c) whole = zero_outside(g.corner_at(p, c));
       if (whole) {
         flat = false;
         break;

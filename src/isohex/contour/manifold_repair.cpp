@@ -155,7 +155,7 @@ class CavityMove {
     bool found = false;
     double best = std::numeric_limits<double>::infinity();
     for (int c = 0; c < 8; ++c) {
-      const std::size_t p = cell + static_cast<std::size_t>((c & 1) + dy_ * (c >> 1 & 1) + dz_ * (c >> 2 & 1));
+      const std::size_t p = g_.corner_at(cell, c);
       // A cavity at L == 0 has no volume: it is filled (fill_degenerate_cavities), not moved
       // to a sample inside the field, whose cavity no surface bounds.
       if (g_.inside[p] || g_.on_isosurface(p) ||
@@ -242,7 +242,6 @@ RepairCounts repair_manifold(SampledGrid& g) {
   RepairCounts counts;
   fill_degenerate_cavities(g, counts);
   fill_zero_level_samples(g, counts);
-  const std::size_t dz = g.padded[0] * g.padded[1];
   std::vector<std::size_t> cells = non_manifold_cells(g);
   simple_phase(g, counts, Search::short_, cells);
   // Where no short sequence exists: cavity moves, prepared sequences, the deep search, the
@@ -275,8 +274,7 @@ RepairCounts repair_manifold(SampledGrid& g) {
     std::uint8_t allowed = 0;
     const std::size_t base = g.index(i, j, k);
     for (int c = 0; c < 8; ++c) {
-      const std::size_t p = base + static_cast<std::size_t>(c & 1) + g.padded[0] * static_cast<std::size_t>(c >> 1 & 1) +
-                            dz * static_cast<std::size_t>(c >> 2 & 1);
+      const std::size_t p = g.corner_at(base, c);
       level[c] = g.level[p];
       if ((cand >> c & 1) && carving_keeps_inside_connected(g, p)) allowed |= static_cast<std::uint8_t>(1u << c);
     }

@@ -48,6 +48,11 @@ struct SampledGrid {
   [[nodiscard]] std::uint8_t cell_mask(std::size_t i, std::size_t j, std::size_t k) const { return cell_mask_at(index(i, j, k)); }
   /// The same for the cell whose lowest corner has padded index `cell`.
   [[nodiscard]] std::uint8_t cell_mask_at(std::size_t cell) const;
+  /// Padded index of corner c (offset (c&1, c>>1&1, c>>2&1)) of the cell whose lowest corner is `cell`.
+  [[nodiscard]] std::size_t corner_at(std::size_t cell, int c) const {
+    const auto u = static_cast<std::size_t>(c);
+    return cell + (u & 1) + padded[0] * (u >> 1 & 1) + padded[0] * padded[1] * (u >> 2 & 1);
+  }
   /// Bit c set when corner c of cell (i, j, k) is padding.
   [[nodiscard]] std::uint8_t padding_mask(std::size_t i, std::size_t j, std::size_t k) const;
 };

@@ -189,9 +189,11 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
   // The terms of the model at y: the frames (and in phase 1 the ratio terms) to raise, as
   // weight-1 terms; in phase 2 the ratio terms as constraints, offset by held_ratio and
   // weighted almost 0 (f >= s·w is then f >= held_ratio, nearly).
-  const auto terms = [&](const Vec3& y, bool value_only, std::vector<double>& w, double& now) {
+  // `raised` is the count of the first terms, those to raise; the constraints follow them.
+  const auto terms = [&](const Vec3& y, bool value_only, std::vector<double>& w, double& now, std::size_t& raised) {
     std::vector<opt::Affine> f = frame_values(mesh, inc, v, y, value_only, std::isnan(held_ratio) ? ratio : nullptr);
     now = lowest(f);
+    raised = f.size();
     w.assign(f.size(), 1.0);
     if (!std::isnan(held_ratio)) {
       std::vector<opt::Affine> r;
@@ -211,7 +213,8 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
     for (int model = 0; model < options.models; ++model) {
       std::vector<double> w;
       double now = 0;
-      std::vector<opt::Affine> f = terms(x, false, w, now);
+      std::size_t raised = 0;
+      std::vector<opt::Affine> f = terms(x, false, w, now, raised);
       // Frames at the target are good enough: no move there, and the model seeks no more (a
       // constant frame at the target caps the LP's bound), so the max–min step does not flatten
       // the shape of hexes that need no help.
@@ -242,11 +245,12 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
         if (!valid || below > below0 || q < m0 || ratio_y < ratio_floor) continue;
         std::vector<double> wy;
         double now_y = 0;
-        const std::vector<opt::Affine> fy = terms(y, true, wy, now_y);
+        std::size_t raised_y = 0;
+        const std::vector<opt::Affine> fy = terms(y, true, wy, now_y, raised_y);
         if (!(now_y > now + 1e-9)) continue;
         if (phase == 2) {  // the ratio terms held, and the certified ratio around v too
           bool held = ratio_y >= ratio0;
-          for (std::size_t i = 0; i < fy.size(); ++i) held = held && (wy[i] == 1.0 || fy[i].b >= 0);
+          for (std::size_t i = raised_y; i < fy.size(); ++i) held = held && fy[i].b >= 0;
           if (!held) continue;
         }
         x = y;
