@@ -235,12 +235,11 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
     const BoundarySurface saved = surface;
     std::size_t n = 0;
     ReleaseRings rings(mesh, inc, sj);
-    for (int reach = 0;; ++reach) {
-      if (reach >= (round > 1 ? 1 : 0)) {
-        candidates = rings.candidates(surface);
-        n = surface.loosen(mesh, candidates, band);
-        if (n > 0 || reach == kMaxReach) break;
-      }
+    if (round > 1) rings.grow();
+    for (int reach = round > 1 ? 1 : 0;; ++reach) {
+      candidates = rings.candidates(surface);
+      n = surface.loosen(mesh, candidates, band);
+      if (n > 0 || reach == kMaxReach) break;
       rings.grow();
     }
     const std::vector<Vec3> points = mesh.points;

@@ -189,18 +189,23 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
   // The terms of the model at y: the frames (and in phase 1 the ratio terms) to raise, as
   // weight-1 terms; in phase 2 the ratio terms as constraints, offset by held_ratio and
   // weighted almost 0 (f >= s·w is then f >= held_ratio, nearly).
-  // `raised` is the count of the first terms, those to raise; the constraints follow them.
-  const auto terms = [&](const Vec3& y, bool value_only, std::vector<double>& w, double& now, std::size_t& raised) {
-    std::vector<opt::Affine> f = frame_values(mesh, inc, v, y, value_only, std::isnan(held_ratio) ? ratio : nullptr);
-    now = lowest(f);
-    raised = f.size();
-    w.assign(f.size(), 1.0);
+  struct Model {
+    std::vector<opt::Affine> f;
+    std::vector<double> w;
+    double now;          // the smallest term to raise
+    std::size_t raised;  // the terms to raise come first; the constraints follow them
+  };
+  const auto terms = [&](const Vec3& y, bool value_only) {
+    Model m{frame_values(mesh, inc, v, y, value_only, std::isnan(held_ratio) ? ratio : nullptr), {}, 0, 0};
+    m.now = lowest(m.f);
+    m.raised = m.f.size();
+    m.w.assign(m.f.size(), 1.0);
     if (!std::isnan(held_ratio)) {
       std::vector<opt::Affine> r;
       ratio_terms(mesh, inc, v, y, value_only, norms, r);
-      for (opt::Affine& a : r) a.b -= held_ratio, f.push_back(a), w.push_back(1e-6);
+      for (opt::Affine& a : r) a.b -= held_ratio, m.f.push_back(a), m.w.push_back(1e-6);
     }
-    return f;
+    return m;
   };
   for (int phase = 1; phase <= (options.ratio_terms ? 2 : 1); ++phase) {
     if (phase == 2) {
@@ -211,10 +216,10 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
     }
     double box = options.step * len;
     for (int model = 0; model < options.models; ++model) {
-      std::vector<double> w;
-      double now = 0;
-      std::size_t raised = 0;
-      std::vector<opt::Affine> f = terms(x, false, w, now, raised);
+      Model m = terms(x, false);
+      std::vector<opt::Affine>& f = m.f;
+      std::vector<double>& w = m.w;
+      const double now = m.now;
       // Frames at the target are good enough: no move there, and the model seeks no more (a
       // constant frame at the target caps the LP's bound), so the max–min step does not flatten
       // the shape of hexes that need no help.
@@ -243,16 +248,12 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
         // raising one hex by bending several others below 0.2 is no gain.
         const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y);
         if (!valid || below > below0 || q < m0 || ratio_y < ratio_floor) continue;
-        std::vector<double> wy;
-        double now_y = 0;
-        std::size_t raised_y = 0;
-        const std::vector<opt::Affine> fy = terms(y, true, wy, now_y, raised_y);
-        if (!(now_y > now + 1e-9)) continue;
-        if (phase == 2) {  // the ratio terms held, and the certified ratio around v too
-          bool held = ratio_y >= ratio0;
-          for (std::size_t i = raised_y; i < fy.size(); ++i) held = held && fy[i].b >= 0;
-          if (!held) continue;
-        }
+        const Model my = terms(y, true);
+        if (!(my.now > now + 1e-9)) continue;
+        // Phase 2: the ratio terms held, and the certified ratio around v too.
+        if (phase == 2 && (ratio_y < ratio0 || std::any_of(my.f.begin() + static_cast<std::ptrdiff_t>(my.raised), my.f.end(),
+                                                           [](const opt::Affine& a) { return a.b < 0; })))
+          continue;
         x = y;
         gained = moved = true;
       }
