@@ -35,6 +35,7 @@ struct Args {
   std::string inside = "above", interpolation = "trilinear", region = "inside", outer;
   double cell_size = 0;
   Index resolution = 0, min_component = 8;
+  double thin_features = 0.1;
   // Raw layout (as in `isohex volume info`).
   std::vector<Index> dims;
   std::string type, endian = "little";
@@ -172,6 +173,7 @@ void run(const Args& a) {
     else opt.cell_size = volume.spacing.maxCoeff();  // one voxel
   }
   opt.min_component = a.min_component;
+  opt.thin_features = a.thin_features;
   if (terminal) opt.on_stage = [](std::string_view s) { fmt::print("  {}...\n", s), std::fflush(stdout); };
 
   fmt::print("{}: {} x {} x {} points, region {} ", a.shape.empty() ? a.volume : "shape", volume.dims[0],
@@ -254,6 +256,9 @@ void run(const Args& a) {
              "of zero width); {} cells split\n",
              r.carved_points, r.filled_points, r.repair_rounds, r.simple_points, r.relocated_points, r.forced_points,
              r.degenerate_points, r.degenerate_components, r.zero_level_points, r.pinch_points, r.split_cells);
+  if (r.thin_points > 0)
+    fmt::print("  thin features: {} samples of filaments within {} cells of the isosurface made outside (of the {} above)\n",
+               r.thin_points, a.thin_features, r.carved_points);
   if (a.min_component > 1)
     fmt::print("  components: {} kept, {} dropped ({} hexes) below {} hexes\n", r.components, r.dropped_components,
                r.dropped_hexes, a.min_component);
@@ -325,6 +330,7 @@ void run(const Args& a) {
     j["degenerate_points"] = r.degenerate_points;
     j["zero_level_points"] = r.zero_level_points;
     j["pinch_points"] = r.pinch_points;
+    j["thin_points"] = r.thin_points;
     // Every sample the repair flipped, so that the topology claims can be checked.
     nlohmann::json edits = nlohmann::json::array();
     for (const auto& e : r.edits) {
@@ -337,6 +343,7 @@ void run(const Args& a) {
                                 : e.kind == contour::RepairKind::degenerate ? "degenerate"
                                 : e.kind == contour::RepairKind::zero_level ? "zero_level"
                                 : e.kind == contour::RepairKind::pinch      ? "pinch"
+                                : e.kind == contour::RepairKind::thin       ? "thin"
                                                                             : "forced"}});
     }
     j["repair_edits"] = edits;
@@ -398,6 +405,12 @@ void register_mesh(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("mesh", "Hex mesh of a volume's isosurface region: dual-contouring extraction, surface "
                                              "smoothing, boundary pillowing, untangling and mean-ratio optimisation, "
                                              "verification");
+  cmd->footer(
+      "Examples:\n"
+      "  isohex mesh head.nrrd --iso 1150 --cell-size 3.2 -o head.vtu --json head.json\n"
+      "  isohex mesh cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 "
+      "--cell-size 3 -o skin.inp\n"
+      "  isohex mesh --shape \"torus(0,0,0, 1,0.4)\" --resolution 40 -o torus.vtu");
   cmd->add_option("volume", a->volume, "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)");
   cmd->add_option("--shape", a->shape, "Mesh an implicit shape expression instead (inside where its distance < ISO, default 0)");
   cmd->add_option("--iso", a->iso, "Isovalue");
@@ -418,6 +431,11 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--min-component", a->min_component,
                   "Drop connected parts with fewer hexes (default 8: a part smaller than a 2x2x2 block of cells is below "
                   "the cell size, mostly a scan's noise, and would float free in a solver; 0 keeps every part)");
+  cmd->add_option("--thin-features", a->thin_features,
+                  "Carve, from their tips, filaments one sample thick whose samples lie within F cells of the isosurface "
+                  "(default 0.1: wisps far thinner than a cell, whose boundary quads fold round them and whose hexes "
+                  "cannot reach a scaled Jacobian of 0.2; 0 keeps them)")
+      ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--refine-boundary", a->refine_tolerance,
                   "Refine (by 3, conforming templates) the hexes under boundary quads that chord the isosurface "
                   "deeper than TOL x cell size, new boundary vertices on the isosurface (e.g. 0.02)")

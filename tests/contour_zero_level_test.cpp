@@ -20,16 +20,7 @@ namespace isohex::contour {
 namespace {
 
 // An 8^3 unit-spaced volume: a 6^3 solid of 1 in a layer of 0, with the listed values set.
-Volume block(const std::vector<std::pair<std::array<Index, 3>, float>>& set) {
-  Volume v;
-  v.dims = {8, 8, 8};
-  v.values.assign(v.size(), 0.0f);
-  for (Index z = 1; z < 7; ++z)
-    for (Index y = 1; y < 7; ++y)
-      for (Index x = 1; x < 7; ++x) v.at(x, y, z) = 1.0f;
-  for (const auto& [p, value] : set) v.at(p[0], p[1], p[2]) = value;
-  return v;
-}
+Volume block(const std::vector<std::pair<std::array<Index, 3>, float>>& set) { return test::block_volume(8, set); }
 
 RegionSpec half() {
   RegionSpec spec;

@@ -294,6 +294,29 @@ TEST(MeshCli, SpecksBelowTheMinimumComponentAreDroppedByDefault) {
   EXPECT_FALSE(std::filesystem::exists(dir / "c.vtu"));
 }
 
+// `--thin-features F` end to end: a filament one sample thick off a block, its samples just
+// above the isovalue, is carved (the JSON counts it, edit kind "thin") and the mesh is valid;
+// `--thin-features 0` keeps it; a negative value is refused with exit 2, nothing written.
+TEST(MeshCli, ThinFeaturesAreCarvedUnlessTurnedOff) {
+  const auto dir = scratch_dir();
+  std::vector<std::pair<std::array<Index, 3>, float>> set;
+  for (Index x = 7; x < 11; ++x) set.push_back({{x, 3, 3}, 0.52f});
+  write_volume(dir / "filament.vti", test::block_volume(14, set));
+  std::string out;
+  const std::string base = "mesh " + q(dir / "filament.vti") + " --iso 0.5 --cell-size 1 --no-smooth --no-pillow --min-component 0 ";
+  ASSERT_EQ(run_cli(base + "-o " + q(dir / "a.vtu") + " --json " + q(dir / "a.json"), &out), 0) << out;
+  ASSERT_EQ(run_cli(base + "--thin-features 0 -o " + q(dir / "b.vtu") + " --json " + q(dir / "b.json"), &out), 0) << out;
+  const auto a = nlohmann::json::parse(io::read_file(dir / "a.json"));
+  const auto b = nlohmann::json::parse(io::read_file(dir / "b.json"));
+  EXPECT_EQ(a["thin_points"], 4);
+  EXPECT_EQ(b["thin_points"], 0);
+  EXPECT_TRUE(validate(io::read_mesh(dir / "a.vtu")).valid());
+  EXPECT_LT(io::read_mesh(dir / "a.vtu").num_hexes(), io::read_mesh(dir / "b.vtu").num_hexes());
+  EXPECT_EQ(run_cli(base + "--thin-features -1 -o " + q(dir / "c.vtu"), &out), 2);
+  EXPECT_NE(out.find("--thin-features"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "c.vtu"));
+}
+
 // `isohex smooth --boundary slide --volume V --surface-band F`: the same release as `isohex
 // mesh`, F in mean boundary edge lengths. On bucky (extraction and pillowing by `isohex mesh
 // --no-smooth`), sliding alone leaves hexes below 0.2 and inverted; with the band, fewer, and

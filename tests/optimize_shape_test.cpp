@@ -212,3 +212,75 @@ TEST(OptimizeShape, WorstPassRaisesTiedMinimum) {
   for (std::size_t i = 0; i < m.points.size(); ++i)
     if (m.fixed[i]) EXPECT_EQ(one.points[i], before.points[i]);
 }
+
+namespace {
+
+// Four hexes around one free vertex, from headsq at h 3.2: three pillow hexes at a convex
+// corner (boundary vertex of valence 3) with ratio bounds 0.093-0.098, and the inner hex
+// behind them at scaled Jacobian 0.277; plus a lone sheared hex, all fixed, at 0.21 (the
+// mesh minimum). Coordinates relative to the free vertex, in mm.
+HexMesh pillow_corner() {
+  HexMesh m;
+  m.points = {{1.043354433643529, -4.4976607103025188, -0.27866158158436605},
+              {3.5379593803888838, -1.2727020584566446, -2.3391643170902974},
+              {3.4958387706007841, 0.30156314023351172, -0.62199661212294188},
+              {0.81883789138655061, -4.0412781459122726, 1.734628690419953},
+              {0.53983377983567493, -0.34641993375638691, -0.02466668714641429},
+              {1.5413323227928117, -2.3290581255536935, 3.2099501595670503},
+              {4.517647314289718, -0.91565919376342464, 0.72873615703875316},
+              {-1.9153386607025737, -2.5380467918316469, -0.91127867761269954},
+              {0.34441334309397575, -0.27709572408745942, -1.6934891622815123},
+              {-1.9854415694497334, -0.35494853065938514, 0.64206542531774602},
+              {0.19557691575458591, 0.90658370938177057, -0.32801963408370938},
+              {-2.523019636064717, -2.1201020473928622, 1.9298577400069696},
+              {0, 0, 0},
+              {-1.9974536260536411, 0.20109008314840082, 2.9191082390983425},
+              {0.061646207002269193, 1.4329546930219266, 1.097776692063146}};
+  m.hexes = {{7, 8, 10, 9, 11, 12, 14, 13}, {0, 3, 4, 1, 7, 11, 12, 8}, {1, 4, 6, 2, 8, 12, 14, 10}, {3, 5, 6, 4, 11, 13, 14, 12}};
+  const double a = std::sqrt(1 / (0.21 * 0.21) - 1);  // shear: every corner's scaled Jacobian 0.21
+  const Index o = static_cast<Index>(m.points.size());
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 c(k == 1 || k == 2 || k == 5 || k == 6, k == 2 || k == 3 || k == 6 || k == 7, k >= 4);
+    m.points.push_back(Vec3(20, 0, 0) + c + Vec3(a * c.z(), 0, 0));
+  }
+  m.hexes.push_back({o, o + 1, o + 2, o + 3, o + 4, o + 5, o + 6, o + 7});
+  m.fixed.assign(m.points.size(), 1);
+  m.fixed[12] = 0;
+  return m;
+}
+
+}  // namespace
+
+// The ratio terms may take the scaled Jacobian of a neighbour down (to sj_floor, not below the
+// mesh minimum) where no other move raises a ratio: the old rule (the local minimum never
+// falls; sj_floor = 1 restores it) leaves the pillow corner's ratios below 0.1.
+TEST(OptimizeShape, WorstPassTradesScaledJacobianForRatio) {
+  const HexMesh before = pillow_corner();
+  const double lo = min_sj(before);
+  ASSERT_NEAR(lo, 0.21, 1e-9);
+  ASSERT_LT(min_ratio_bound(before), 0.095);
+  HexMesh held = before, traded = before;
+  WorstOptions wo;
+  wo.sj_floor = 1;
+  improve_worst(held, held.fixed, wo);
+  EXPECT_LT(min_ratio_bound(held), 0.1);
+  improve_worst(traded, traded.fixed);
+  EXPECT_GE(min_ratio_bound(traded), 0.1);
+  EXPECT_GE(min_sj(traded), lo);
+  for (Index h = 0; h < 4; ++h) {
+    EXPECT_GE(scaled_jacobian(traded.corners(h)), 0.2);
+    EXPECT_TRUE(certified_valid(traded.corners(h), 0.0));
+    EXPECT_LE(edge_ratio(traded.corners(h)), std::max(edge_ratio(before.corners(h)), wo.poor_ratio_edge_limit));
+  }
+  // With caps of 1 the largest edge ratio around the vertex may not rise at all.
+  HexMesh capped = before;
+  wo = WorstOptions{};
+  wo.max_edge_ratio = wo.poor_ratio_edge_limit = 1;
+  improve_worst(capped, capped.fixed, wo);
+  const auto largest = [](const HexMesh& m) {
+    double hi = 0;
+    for (Index h = 0; h < 4; ++h) hi = std::max(hi, edge_ratio(m.corners(h)));
+    return hi;
+  };
+  EXPECT_LE(largest(capped), largest(before));
+}

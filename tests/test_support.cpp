@@ -41,6 +41,17 @@ Volume shared_volume(const std::string& file) {
   return read_volume(shared_data("volumes/" + file), opt);
 }
 
+Volume block_volume(Index n, const std::vector<std::pair<std::array<Index, 3>, float>>& set) {
+  Volume v;
+  v.dims = {n, n, n};
+  v.values.assign(v.size(), 0.0f);
+  for (Index z = 1; z < 7; ++z)
+    for (Index y = 1; y < 7; ++y)
+      for (Index x = 1; x < 7; ++x) v.at(x, y, z) = 1.0f;
+  for (const auto& [p, value] : set) v.at(p[0], p[1], p[2]) = value;
+  return v;
+}
+
 std::array<Vec3, 8> unit_cube() {
   return {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0),
           Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(1, 1, 1), Vec3(0, 1, 1)};

@@ -7,6 +7,8 @@
 #include <array>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace isohex::test {
 
@@ -21,6 +23,10 @@ Volume shared_volume(const std::string& file);
 std::filesystem::path scratch_dir();
 /// An nx*ny*nz grid of unit-spaced hexes (spacing h), vertices numbered x fastest.
 HexMesh grid_mesh(int nx, int ny, int nz, double h = 1.0);
+
+/// An n^3 unit-spaced volume of 0 holding a 6^3 block of 1 (samples 1..6 on each axis), then
+/// the listed samples set to the listed values (n >= 8).
+Volume block_volume(Index n, const std::vector<std::pair<std::array<Index, 3>, float>>& set);
 
 /// The corners of the unit cube in VTK order.
 std::array<Vec3, 8> unit_cube();

@@ -335,7 +335,17 @@ ExtractResult extract_hex_mesh(const Region& region, const ExtractOptions& optio
   rep.time_sample = seconds_since(t);
 
   t = stage("manifold repair");
-  const RepairCounts repaired = repair_manifold(g);
+  // Filaments thinner than the option are carved first; the repair then mends what that leaves.
+  RepairCounts repaired;
+  carve_thin_features(g, options.thin_features, repaired);
+  {
+    RepairCounts rest = repair_manifold(g);
+    rest.edits.insert(rest.edits.begin(), repaired.edits.begin(), repaired.edits.end());
+    rest.carved += repaired.carved;
+    rest.thin = repaired.thin;
+    repaired = std::move(rest);
+  }
+  rep.thin_points = repaired.thin;
   rep.filled_points = repaired.filled;
   rep.carved_points = repaired.carved;
   rep.simple_points = repaired.simple;

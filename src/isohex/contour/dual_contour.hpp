@@ -67,6 +67,8 @@ enum class RepairKind : std::uint8_t {
   pinch,      ///< a fill where the sides touch with zero width at a sample at L == 0 that several
               ///< cells' dual vertices would share (fill_shared_pins): may change the topology
               ///< by connections of zero width (two cavities touching at one point come apart)
+  thin,       ///< a carve of a filament thinner than a fraction of a cell (carve_thin_features):
+              ///< a simple point (topology kept) or a speck of one sample (a component removed)
 };
 
 /// Where a mesh vertex lies (ExtractResult::vertex_place); values ≥ 0 name a surface of the
@@ -77,6 +79,8 @@ struct ExtractOptions {
   double cell_size = 0;      ///< h in world units; 0 = use `resolution`
   Index resolution = 64;     ///< cells along the domain's longest axis when cell_size is 0
   Index min_component = 0;   ///< drop connected parts with fewer hexes than this
+  /// Carve filaments within this many cells of the isosurface (carve_thin_features); 0 = keep them.
+  double thin_features = 0;
   /// Called as each stage starts ("sampling", "manifold repair", ...), e.g. for progress.
   std::function<void(std::string_view stage)> on_stage;
 };
@@ -95,6 +99,7 @@ struct ExtractReport {
   std::size_t degenerate_points = 0;      ///< of the filled, their samples
   std::size_t zero_level_points = 0;      ///< of the filled, samples at L == 0 made inside (simple; topology kept)
   std::size_t pinch_points = 0;           ///< of the filled, pinches of zero width made inside (RepairKind::pinch)
+  std::size_t thin_points = 0;            ///< made outside before the repair: filaments thinner than thin_features (RepairKind::thin)
   /// Every flip of the repair in the order made: grid point (i, j, k), its state after the
   /// flip (true = made inside), and its kind. Applied to the samples, the simple, zero_level and
   /// relocated ones keep marching cubes' topology and all of them give the mesh's topology; the

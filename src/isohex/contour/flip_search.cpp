@@ -23,16 +23,6 @@ int non_manifold_around(const SampledGrid& g, std::size_t p) {
   return n;
 }
 
-bool simple_at(const SampledGrid& g, std::size_t p) {
-  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
-  Neighbourhood nb{};
-  for (int z = 0; z < 3; ++z)
-    for (int y = 0; y < 3; ++y)
-      for (int x = 0; x < 3; ++x)
-        nb[static_cast<std::size_t>(x + 3 * y + 9 * z)] = g.inside[p + x + dy * y + dz * z - 1 - dy - dz] != 0;
-  return is_simple_6_18(nb);
-}
-
 }  // namespace
 
 // Not padding, and next to the isosurface: some 26-neighbour was sampled on the other side

@@ -4,6 +4,7 @@
 /// handle_move.cpp): the helpers they share.
 
 #include "isohex/contour/sampled_grid.hpp"
+#include "isohex/contour/simple_point.hpp"
 
 #include <array>
 #include <cstddef>
@@ -17,6 +18,17 @@ inline std::array<std::size_t, 8> cells_around(const SampledGrid& g, std::size_t
   std::array<std::size_t, 8> cells{};
   for (int c = 0; c < 8; ++c) cells[static_cast<std::size_t>(c)] = p - (c & 1) - dy * (c >> 1 & 1) - dz * (c >> 2 & 1);
   return cells;
+}
+
+/// True when padded point p (never padding) is simple for marching cubes' (6, 18) topology.
+inline bool simple_at(const SampledGrid& g, std::size_t p) {
+  const std::size_t dy = g.padded[0], dz = g.padded[0] * g.padded[1];
+  Neighbourhood nb{};
+  for (int z = 0; z < 3; ++z)
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 3; ++x)
+        nb[static_cast<std::size_t>(x + 3 * y + 9 * z)] = g.inside[p + x + dy * y + dz * z - 1 - dy - dz] != 0;
+  return is_simple_6_18(nb);
 }
 
 /// Not padding, and next to the isosurface: some 26-neighbour was sampled on the other side

@@ -72,6 +72,7 @@ struct RepairCounts {
   std::size_t degenerate_components = 0;  ///< zero-volume cavities filled
   std::size_t zero_level = 0;  ///< of the filled, samples at L == 0 on a real surface (fill_zero_level_samples)
   std::size_t pinch = 0;       ///< of the filled, pinches of zero width (fill_shared_pins)
+  std::size_t thin = 0;        ///< of the carved, samples of filaments thinner than a fraction of a cell (carve_thin_features)
   struct Edit {
     std::size_t point;  ///< padded index
     RepairKind kind;
@@ -138,6 +139,23 @@ std::size_t fill_degenerate_cavities(SampledGrid& g, RepairCounts& counts);
 /// sample can make it shared). Adds the fills to `counts` (kind zero_level) and returns their
 /// number.
 std::size_t fill_zero_level_samples(SampledGrid& g, RepairCounts& counts);
+
+/// Carves the filaments thinner than `max_fraction` of a cell from their tips: in grid order
+/// and in rounds until none is left, each inside sample that
+///  - is one sample thick along at least two axes (both neighbours outside on each: a sample
+///    of a filament, a speck, or a strip one sample wide and thick),
+///  - is within `max_fraction` cells of the isosurface along a grid edge (the sampled levels'
+///    linear crossing L / (L − L_q) to an outside, not padding, neighbour q at L_q ≤ 0), and
+///  - is a simple point for marching cubes' (6, 18) topology, or has no inside face neighbour
+///    (a speck, which would be a component of one hex)
+/// is made outside. Such a sample's hex has four or more faces on the boundary round a
+/// cross-section far below a cell: its boundary quads fold round the filament, and no
+/// placement of the pillow hexes on them reaches a scaled Jacobian of 0.2 (cthead's skin at
+/// h 3: wisps one voxel thick). The solid loses at most `max_fraction` cells of thickness
+/// there; every other part of the surface is kept. Sequential, so the result is the same for
+/// any thread count. Adds the carves to `counts` (kind thin, in `carved` and `thin`) and
+/// returns their number.
+std::size_t carve_thin_features(SampledGrid& g, double max_fraction, RepairCounts& counts);
 
 /// Labels the face-connected parts of the inside points (which are the connected parts of
 /// the hex mesh) and removes those with fewer than `min_points` points. Returns the numbers

@@ -36,8 +36,9 @@
 ///   must lower the objective, so the objective never increases.
 /// - improve_worst(): local max–min moves on the vertices of the worst hexes (an LP on the
 ///   linearised frame values of Verdict's scaled Jacobian), accepted only if the smallest of
-///   the values the vertex changes rises, the certified minimum around the vertex does not
-///   fall, and the Bernstein bound of the jacobian ratio stays above WorstOptions::ratio_floor.
+///   the values the vertex changes (frames and ratio terms) rises, the certified minimum around
+///   the vertex stays above WorstOptions::sj_floor (or does not fall), and the Bernstein bound
+///   of the jacobian ratio stays above WorstOptions::ratio_floor (or does not fall).
 ///
 /// Valid means valid inside: every stage treats a hex as valid only when it is certified so by
 /// the Bernstein coefficients of det J (quality/jacobian_bounds.hpp), not by Verdict's nine
@@ -211,10 +212,23 @@ struct WorstOptions {
   double target = 0.6;  ///< a vertex whose frame values are all at least this is not moved
   /// No move may make an edge shorter than this fraction of its length when the pass began.
   double min_edge_shrink = 0.5;
+  /// ... nor raise the edge ratio (longest edge over shortest) of a hex around the vertex above
+  /// the higher of its value before and this: the trade of sj_floor shortened pillow edges
+  /// (headsq's largest edge ratio went from 16 to 34 without it).
+  double max_edge_ratio = 20;
+  /// ... or above the higher of its value before and this where a hex around the vertex has a
+  /// ratio bound below 0.1 (the floor is a target, an edge ratio of 20 an aim: cthead at h 3
+  /// kept 4 ratios below 0.1 with the cap of 20 everywhere).
+  double poor_ratio_edge_limit = 100;
   /// No move may lower the smallest jacobian_ratio_bound() of the hexes around the vertex
   /// below the lower of its value before and this: the nine samples of the scaled Jacobian
   /// are not bought with a distorted interior.
   double ratio_floor = 0.2;
+  /// With ratio_terms, a move may lower the smallest scaled Jacobian around the vertex (to raise
+  /// a ratio term, the model's smallest value rising), but not below the higher of this and the
+  /// mesh minimum: a pillow hex at ratio 0.093 beside a hex at 0.277 (headsq) is raised to
+  /// 0.10 by taking the other to 0.205. Without ratio_terms the local minimum never falls.
+  double sj_floor = 0.2;
   /// The max–min moves also raise the Bernstein coefficients of det J over each hex's largest
   /// (a lower bound of its jacobian ratio, weighted 2: a ratio of 0.1 counts as a scaled
   /// Jacobian of 0.2), and the worst hexes are chosen by the lower of the two. Where a ratio

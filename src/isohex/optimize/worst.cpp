@@ -33,11 +33,12 @@ double sj_value(const std::array<Vec3, 8>& p) {
 // samples det J at nine points, so the pass must not buy them with a distorted interior.
 double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool* valid = nullptr,
                  int* questionable = nullptr, const std::vector<Vec3>* start = nullptr, double shrink = 0,
-                 double* ratio = nullptr) {
+                 double* ratio = nullptr, double* edge_ratio = nullptr) {
   double lo = 2.0;
   if (valid) *valid = true;
   if (questionable) *questionable = 0;
   if (ratio) *ratio = 1.0;
+  if (edge_ratio) *edge_ratio = 1.0;
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     auto p = mesh.corners(h);
@@ -53,6 +54,14 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
     }
     lo = std::min(lo, q);
     if (questionable) *questionable += q < kQuestionableSJ;
+    if (edge_ratio) {
+      double shortest = std::numeric_limits<double>::infinity(), longest = 0;
+      for (const auto& e : kHexEdges) {
+        const double l2 = (p[e[0]] - p[e[1]]).squaredNorm();
+        shortest = std::min(shortest, l2), longest = std::max(longest, l2);
+      }
+      *edge_ratio = std::max(*edge_ratio, shortest > 0 ? std::sqrt(longest / shortest) : std::numeric_limits<double>::infinity());
+    }
     if (!valid) continue;
     if (q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
     for (const auto& e : kHexEdges) {
@@ -171,12 +180,21 @@ double lowest(const std::vector<opt::Affine>& f) {
 // scaled-Jacobian frames alone with the ratio terms held as constraints: none falls below the
 // smallest of them now, and the certified ratio around v does not fall either.
 bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector<Vec3>& start,
-                 const BoundarySurface* surface, const WorstOptions& options) {
+                 const BoundarySurface* surface, const WorstOptions& options, double mesh_min) {
   const Vec3 x0 = mesh.points[v];
   int below0 = 0;
   double ratio0 = 1;
-  const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0, nullptr, 0, &ratio0);
+  double edges0 = 1;
+  const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0, nullptr, 0, &ratio0, &edges0);
+  // Raising a ratio below the floor (0.1) outranks the edge-ratio aim: such a vertex may go
+  // up to the limit instead.
+  const double edge_cap =
+      std::max(edges0, options.ratio_terms && ratio0 < kPoorJacobianRatio ? options.poor_ratio_edge_limit
+                                                                          : options.max_edge_ratio);
   const double ratio_floor = std::min(ratio0, options.ratio_floor);
+  // With the ratio terms, the scaled Jacobian around v may fall to buy a ratio, but not below
+  // the higher of sj_floor and the mesh minimum (so that never falls); without them it holds.
+  const double sj_floor = options.ratio_terms ? std::min(m0, std::max(options.sj_floor, mesh_min)) : m0;
   const std::vector<double> norms = options.ratio_terms ? ratio_norms(mesh, inc, v) : std::vector<double>{};
   const std::vector<double>* ratio = options.ratio_terms ? &norms : nullptr;
   const double len = opt::mean_edge_at(mesh, inc, v);
@@ -243,15 +261,17 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
         if (surface && !surface->put_back(v, y, n, len)) continue;  // off the surface (or band): refused
         bool valid = false;
         int below = 0;
-        double ratio_y = 1;
+        double ratio_y = 1, edges_y = 1;
         // A negative local minimum may rise while a valid neighbour is inverted on the way;
         // raising one hex by bending several others below 0.2 is no gain.
-        const double q = local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y);
-        if (!valid || below > below0 || q < m0 || ratio_y < ratio_floor) continue;
+        const double q =
+            local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y, &edges_y);
+        if (!valid || below > below0 || q < sj_floor || ratio_y < ratio_floor || edges_y > edge_cap) continue;
         const Model my = terms(y, true);
         if (!(my.now > now + 1e-9)) continue;
-        // Phase 2: the ratio terms held, and the certified ratio around v too.
-        if (phase == 2 && (ratio_y < ratio0 || std::any_of(my.f.begin() + static_cast<std::ptrdiff_t>(my.raised), my.f.end(),
+        // Phase 2: the ratio terms held, and the certified ratio around v too; the scaled
+        // Jacobian it raises may not fall.
+        if (phase == 2 && (ratio_y < ratio0 || q < m0 || std::any_of(my.f.begin() + static_cast<std::ptrdiff_t>(my.raised), my.f.end(),
                                                            [](const opt::Affine& a) { return a.b < 0; })))
           continue;
         x = y;
@@ -297,13 +317,14 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return rank[a] < rank[b]; });
     std::size_t moved = 0;
+    const double min_now = mesh_min();
     for (std::size_t i = 0;
          i < order.size() && ((i < options.count && rank[order[i]] < options.below) || rank[order[i]] < options.raise_below);
          ++i) {
       for (Index v : mesh.hexes[order[i]]) {
         if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
         seen[v] = pass;
-        if (!move_vertex(mesh, inc, v, start, options.surface, options)) continue;
+        if (!move_vertex(mesh, inc, v, start, options.surface, options, min_now)) continue;
         ++moved;
         for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
       }
