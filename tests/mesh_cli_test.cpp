@@ -261,6 +261,15 @@ TEST(MeshCli, SurfaceBandReleasesKnifeEdgesWithinTheBand) {
   EXPECT_LE(off, static_cast<std::size_t>(loose));
 }
 
+// Runs `base -o DIR/NAME.vtu --json DIR/NAME.json` (must succeed) and returns the report.
+namespace {
+nlohmann::json mesh_report(const std::string& base, const std::filesystem::path& dir, const std::string& name) {
+  std::string out;
+  EXPECT_EQ(run_cli(base + "-o " + q(dir / (name + ".vtu")) + " --json " + q(dir / (name + ".json")), &out), 0) << out;
+  return nlohmann::json::parse(io::read_file(dir / (name + ".json")));
+}
+}  // namespace
+
 // The default --min-component 8 drops a part below a 2x2x2 block of cells (a one-voxel speck
 // beside a solid block: noise at this cell size, and a free-floating body in a solver);
 // --min-component 0 keeps it, with one more boundary component.
@@ -276,10 +285,8 @@ TEST(MeshCli, SpecksBelowTheMinimumComponentAreDroppedByDefault) {
   write_volume(dir / "speck.vti", v);
   std::string out;
   const std::string base = "mesh " + q(dir / "speck.vti") + " --iso 0.5 --no-smooth --no-pillow ";
-  ASSERT_EQ(run_cli(base + "-o " + q(dir / "a.vtu") + " --json " + q(dir / "a.json"), &out), 0) << out;
-  ASSERT_EQ(run_cli(base + "--min-component 0 -o " + q(dir / "b.vtu") + " --json " + q(dir / "b.json"), &out), 0) << out;
-  const auto a = nlohmann::json::parse(io::read_file(dir / "a.json"));
-  const auto b = nlohmann::json::parse(io::read_file(dir / "b.json"));
+  const auto a = mesh_report(base, dir, "a");
+  const auto b = mesh_report(base + "--min-component 0 ", dir, "b");
   EXPECT_EQ(a["dropped_components"], 1);
   EXPECT_EQ(a["dropped_hexes"], 1);
   EXPECT_EQ(b["dropped_components"], 0);
@@ -304,10 +311,8 @@ TEST(MeshCli, ThinFeaturesAreCarvedUnlessTurnedOff) {
   write_volume(dir / "filament.vti", test::block_volume(14, set));
   std::string out;
   const std::string base = "mesh " + q(dir / "filament.vti") + " --iso 0.5 --cell-size 1 --no-smooth --no-pillow --min-component 0 ";
-  ASSERT_EQ(run_cli(base + "-o " + q(dir / "a.vtu") + " --json " + q(dir / "a.json"), &out), 0) << out;
-  ASSERT_EQ(run_cli(base + "--thin-features 0 -o " + q(dir / "b.vtu") + " --json " + q(dir / "b.json"), &out), 0) << out;
-  const auto a = nlohmann::json::parse(io::read_file(dir / "a.json"));
-  const auto b = nlohmann::json::parse(io::read_file(dir / "b.json"));
+  const auto a = mesh_report(base, dir, "a");
+  const auto b = mesh_report(base + "--thin-features 0 ", dir, "b");
   EXPECT_EQ(a["thin_points"], 4);
   EXPECT_EQ(b["thin_points"], 0);
   EXPECT_TRUE(validate(io::read_mesh(dir / "a.vtu")).valid());
