@@ -39,6 +39,7 @@ struct Args {
   std::optional<int> max_iter;  ///< unset: each stage's own limit (untangle 200, shape 100)
   double tol = 1e-5, margin = 0.05;
   double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
+  int patch_rounds = WorstOptions{}.patch_rounds;  ///< --patch-rounds
   int* threads = nullptr;
 };
 
@@ -129,6 +130,7 @@ void run(const Args& a) {
     o.shape_options.max_iter = *a.max_iter;
   }
   o.shape_options.tol = a.tol;
+  o.worst_options.patch_rounds = a.patch_rounds;
   o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
   o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
   report.update(run_optimisation(mesh, fixed, o));
@@ -186,6 +188,10 @@ void register_smooth(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "smooth", "Untangle and optimise element shape (inverse mean ratio), vertices on the boundary fixed by default");
+  cmd->footer(
+      "Examples:\n"
+      "  isohex smooth tangled.vtk -o smooth.vtu --untangle --json smooth.json\n"
+      "  isohex smooth pillowed.vtu -o out.vtu --untangle --boundary slide --surface-band 0.3 --patch-rounds 10");
   cmd->add_option("mesh", a->in, "Input hex mesh (.vtk .vtu .mesh .inp)")->required();
   cmd->add_option("-o,--output", a->out, "Output mesh")->required();
   cmd->add_flag("--untangle", a->untangle, "First make every hex valid (scaled Jacobian >= --margin where possible)");
@@ -220,6 +226,10 @@ void register_smooth(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--margin", a->margin, "Untangling target for the minimum scaled Jacobian (default 0.05)");
   cmd->add_flag("--no-worst", a->no_worst, "Skip the worst-element pass");
+  cmd->add_option("--patch-rounds", a->patch_rounds,
+                  "Rounds of joint moves that end the worst-element pass: the free vertices of each cluster of hexes "
+                  "still below 0.2 move together, where single moves stall (default 5; 0: off)")
+      ->check(CLI::Range(0, 100));
   cmd->add_option("--json", a->json, "Write a JSON report (before/after quality, stage results)");
   cmd->add_flag("--skip-non-hex", a->skip_non_hex, "Drop non-hexahedral cells instead of failing");
   a->threads = add_threads_option(cmd);

@@ -11,43 +11,53 @@
 
 namespace isohex::opt {
 
-MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w, double box) {
-  MaxMin out;
-  const int m = static_cast<int>(f.size());
-  if (m == 0 || !(box > 0)) return out;
-  // Unknowns y = (u, σ) >= 0 with d = box·(u − 1), u <= 2 (the cube), and s = σ − S, S chosen
-  // so that y = 0 is feasible: f_i(d) >= s·w_i  ⇔  −box a_i·u + w_i σ <= b_i − box a_i·1 + S w_i.
+MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<double>& b, const std::vector<double>& w,
+                       const std::vector<double>& box) {
+  MaxMinN out;
+  const int m = static_cast<int>(b.size());
+  if (m == 0 || n <= 0) return out;
+  for (double x : box)
+    if (!(x > 0)) return out;
+  const auto A = [&](int i, int j) { return a[static_cast<std::size_t>(i) * n + j]; };
+  // Unknowns y = (u, σ) >= 0 with d_j = box_j (u_j − 1), u_j <= 2 (the box), and s = σ − S, S
+  // chosen so that y = 0 is feasible: f_i(d) >= s·w_i  ⇔  −Σ box_j a_ij u_j + w_i σ <= b_i − Σ box_j a_ij + S w_i.
+  std::vector<double> shift(m, 0.0);
   double S = 0;
-  for (int i = 0; i < m; ++i) S = std::max(S, (box * f[i].a.sum() - f[i].b) / w[i]);
-  S += 1;
-  const int rows = m + 3;
-  // Dictionary form: x_B[i] = q[i] − Σ_j M[i][j] x_N[j], objective z = const + Σ_j c[j] x_N[j].
-  std::vector<double> M(static_cast<std::size_t>(rows) * 4, 0.0), q(rows);
-  std::vector<int> B(rows), N{0, 1, 2, 3};
-  auto at = [&](int i, int j) -> double& { return M[static_cast<std::size_t>(i) * 4 + j]; };
   for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < 3; ++j) at(i, j) = -box * f[i].a[j];
-    at(i, 3) = w[i];
-    q[i] = f[i].b - box * f[i].a.sum() + S * w[i];
+    for (int j = 0; j < n; ++j) shift[i] += box[j] * A(i, j);
+    S = std::max(S, (shift[i] - b[i]) / w[i]);
   }
-  for (int j = 0; j < 3; ++j) {
+  S += 1;
+  const int rows = m + n, cols = n + 1;
+  // Dictionary form: x_B[i] = q[i] − Σ_j M[i][j] x_N[j], objective z = const + Σ_j c[j] x_N[j].
+  std::vector<double> M(static_cast<std::size_t>(rows) * cols, 0.0), q(rows), c(cols, 0.0);
+  std::vector<int> B(rows), N(cols);
+  auto at = [&](int i, int j) -> double& { return M[static_cast<std::size_t>(i) * cols + j]; };
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < n; ++j) at(i, j) = -box[j] * A(i, j);
+    at(i, n) = w[i];
+    q[i] = b[i] - shift[i] + S * w[i];
+  }
+  for (int j = 0; j < n; ++j) {
     at(m + j, j) = 1;
     q[m + j] = 2;
   }
-  for (int i = 0; i < rows; ++i) B[i] = 4 + i;
-  double c[4] = {0, 0, 0, 1};  // reduced costs; the objective value itself is read off the solution
+  for (int j = 0; j < cols; ++j) N[j] = j;
+  for (int i = 0; i < rows; ++i) B[i] = cols + i;
+  c[n] = 1;  // reduced costs; the objective value itself is read off the solution
   constexpr double tol = 1e-12;
   for (int pivots = 0; pivots < 50 * rows; ++pivots) {
     // Bland's rule (smallest variable index enters and leaves) cannot cycle.
     int e = -1;
-    for (int j = 0; j < 4; ++j)
+    for (int j = 0; j < cols; ++j)
       if (c[j] > tol && (e < 0 || N[j] < N[e])) e = j;
     if (e < 0) {
-      double y[4] = {0, 0, 0, 0};
+      std::vector<double> y(cols, 0.0);
       for (int i = 0; i < rows; ++i)
-        if (B[i] < 4) y[B[i]] = q[i];
-      out.d = box * (Vec3(y[0], y[1], y[2]) - Vec3::Ones());
-      out.s = y[3] - S;
+        if (B[i] < cols) y[B[i]] = q[i];
+      out.d.resize(n);
+      for (int j = 0; j < n; ++j) out.d[j] = box[j] * (y[j] - 1.0);
+      out.s = y[n] - S;
       out.ok = true;
       return out;
     }
@@ -58,21 +68,36 @@ MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w
       const double ratio = q[i] / at(i, e);
       if (r < 0 || ratio < best || (ratio == best && B[i] < B[r])) r = i, best = ratio;
     }
-    if (r < 0) return out;  // unbounded: cannot happen with the cube and w > 0
+    if (r < 0) return out;  // unbounded: cannot happen with the box and w > 0
     const double p = at(r, e);
-    for (int j = 0; j < 4; ++j) at(r, j) = j == e ? 1 / p : at(r, j) / p;
+    for (int j = 0; j < cols; ++j) at(r, j) = j == e ? 1 / p : at(r, j) / p;
     q[r] /= p;
     for (int i = 0; i < rows; ++i) {
       if (i == r) continue;
       const double k = at(i, e);
       if (k == 0) continue;
-      for (int j = 0; j < 4; ++j) at(i, j) = j == e ? -k / p : at(i, j) - k * at(r, j);
+      for (int j = 0; j < cols; ++j) at(i, j) = j == e ? -k / p : at(i, j) - k * at(r, j);
       q[i] = std::max(q[i] - k * q[r], 0.0);  // clamp rounding: the dictionary stays feasible
     }
     const double ce = c[e];
-    for (int j = 0; j < 4; ++j) c[j] = j == e ? -ce / p : c[j] - ce * at(r, j);
+    for (int j = 0; j < cols; ++j) c[j] = j == e ? -ce / p : c[j] - ce * at(r, j);
     std::swap(B[r], N[e]);
   }
+  return out;
+}
+
+MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w, double box) {
+  std::vector<double> a(3 * f.size()), b(f.size());
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    for (int j = 0; j < 3; ++j) a[3 * i + j] = f[i].a[j];
+    b[i] = f[i].b;
+  }
+  const MaxMinN r = max_min_affine(3, a, b, w, {box, box, box});
+  MaxMin out;
+  if (!r.ok) return out;
+  out.d = Vec3(r.d[0], r.d[1], r.d[2]);
+  out.s = r.s;
+  out.ok = true;
   return out;
 }
 

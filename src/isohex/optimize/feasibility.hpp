@@ -35,6 +35,16 @@ struct MaxMin {
 /// with Bland's rule: exact arithmetic order, so the same bits on every run.
 MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w, double box);
 
+/// The same LP in n unknowns: max s s.t. Σ_j a[i n + j] d_j + b_i >= s·w_i, |d_j| <= box_j (the
+/// joint move of several vertices). `d` has n entries when ok.
+struct MaxMinN {
+  std::vector<double> d;
+  double s = 0;
+  bool ok = false;
+};
+MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<double>& b, const std::vector<double>& w,
+                       const std::vector<double>& box);
+
 /// d det(A + d cᵀ)/dd: the gradient of a frame's determinant when one of its corners moves by d
 /// and c is that corner's coefficient in the frame (frame_coefficient()).
 Vec3 det_gradient(const Mat3& A, const Vec3& c);

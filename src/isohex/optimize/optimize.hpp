@@ -235,6 +235,19 @@ struct WorstOptions {
   /// term is the smallest and cannot rise, a second phase raises the scaled-Jacobian frames
   /// alone with the ratio terms held at their smallest (LP constraints).
   bool ratio_terms = true;
+  /// After the single moves: up to this many rounds of joint moves (0: none), each followed by
+  /// up to 10 more single passes. A max–min ascent one vertex at a time stops where two
+  /// vertices' terms tie and either moving alone lowers the other's (cthead's bone at iso 1200,
+  /// h 5: four pillow hexes at ratios 0.05-0.06 through 100 passes). Each cluster of hexes
+  /// still below 0.2 by the pass's rank (sharing vertices) has the free vertices of its hexes
+  /// moved together, one LP over all their coordinates (opt::move_patch), or where that gains
+  /// nothing those of its worst hex, under the same guards as a single move.
+  int patch_rounds = 5;
+  std::size_t patch_size = 48;  ///< ... at most this many vertices in one patch
+  /// ... and only while at most this many hexes are below 0.2 by rank: more are not stalls of
+  /// the single moves but a region no joint move repairs (headsq with its boundary fixed kept
+  /// 746 through five rounds that cost 6 times the rest of the stage).
+  std::size_t patch_max_poor = 100;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };
@@ -243,6 +256,7 @@ struct WorstOptions {
 struct WorstResult {
   int passes = 0;
   std::size_t moves = 0;
+  std::size_t patch_moves = 0;  ///< joint moves of patches (WorstOptions::patch_rounds)
   double min_sj_before = 0, min_sj_after = 0;
 };
 

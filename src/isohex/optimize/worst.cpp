@@ -3,6 +3,7 @@
 #include "isohex/optimize/feasibility.hpp"
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
+#include "isohex/optimize/patch.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/jacobian_bounds.hpp"
@@ -68,9 +69,7 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
   return lo;
 }
 
-// The ratio terms are weighted kRatioWeight against the scaled Jacobian's frame values: 2 puts
-// a ratio of 0.1 (poor, kPoorJacobianRatio) level with a scaled Jacobian of 0.2.
-constexpr double kRatioWeight = 2;
+using opt::kRatioWeight;
 
 // The largest Bernstein coefficient of det J of each hex around v as the mesh stands (in
 // incidence order; 0 for a hex with none positive): the ratio terms' constant normalisation
@@ -305,33 +304,96 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   std::vector<Index> order(mesh.hexes.size());
   std::vector<Index> seen(mesh.points.size(), -1);
   const std::vector<Vec3> start = mesh.points;
-  for (int pass = 1; pass <= options.passes; ++pass) {
-    // Sequential and in a fixed order (worst first, ties by id): deterministic, and cheap
-    // since only a few hundred vertices take part.
+  const auto sort_worst_first = [&] {  // a fixed order: worst first, ties by id
     std::iota(order.begin(), order.end(), 0);
     std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return rank[a] < rank[b]; });
+  };
+  int pass = 0;
+  const auto single_passes = [&](int passes) {
+    for (int end = pass + passes; pass < end;) {
+      // Sequential: deterministic, and cheap since only a few hundred vertices take part.
+      ++pass;
+      sort_worst_first();
+      std::size_t moved = 0;
+      const double min_now = mesh_min();
+      for (std::size_t i = 0;
+           i < order.size() && ((i < options.count && rank[order[i]] < options.below) || rank[order[i]] < options.raise_below);
+           ++i) {
+        for (Index v : mesh.hexes[order[i]]) {
+          if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
+          seen[v] = pass;
+          if (!move_vertex(mesh, inc, v, start, options.surface, options, min_now)) continue;
+          ++moved;
+          for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
+        }
+      }
+      res.passes = pass;
+      res.moves += moved;
+      res.min_sj_after = mesh_min();
+      if (options.progress) {
+        std::size_t inverted = 0;
+        for (double x : sj) inverted += x <= 0;
+        options.progress({"worst", pass, static_cast<double>(moved), res.min_sj_after, inverted});
+      }
+      if (moved == 0) break;
+    }
+  };
+  single_passes(options.passes);
+  // The end game: the hexes still below 0.2 by rank, each with its free vertices moved together,
+  // then (where that gains nothing) with those of the hexes sharing a vertex with it; the single
+  // moves again after a round that moved something.
+  const auto free_vertices_of = [&](const std::vector<Index>& hexes) {
+    std::vector<Index> p;
+    for (Index h : hexes)
+      for (Index v : mesh.hexes[h])
+        if (fixed.empty() || !fixed[v]) p.push_back(v);
+    std::sort(p.begin(), p.end());
+    p.erase(std::unique(p.begin(), p.end()), p.end());
+    return p;
+  };
+  // The hexes below 0.2 by rank that share a vertex with h, and so on (ascending): a cluster of
+  // poor hexes at one bad spot of the boundary tie with each other.
+  std::vector<std::uint8_t> clustered(mesh.hexes.size(), 0);
+  const auto cluster_of = [&](Index h) {
+    std::vector<Index> c{h};
+    clustered[h] = 1;
+    for (std::size_t i = 0; i < c.size() && c.size() < options.patch_size; ++i)
+      for (Index v : mesh.hexes[c[i]])
+        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+          if (const Index g = inc.ids[k]; !clustered[g] && rank[g] < kQuestionableSJ) clustered[g] = 1, c.push_back(g);
+    std::sort(c.begin(), c.end());
+    return c;
+  };
+  for (int round = 0; round < options.patch_rounds; ++round) {
+    sort_worst_first();
+    // The end game only: with more hexes below 0.2 than patch_max_poor, they are not single
+    // stalls but a region the joint moves cannot repair (a boundary held fixed at knife edges).
+    if (options.patch_max_poor < order.size() && rank[order[options.patch_max_poor]] < kQuestionableSJ) break;
+    std::fill(clustered.begin(), clustered.end(), 0);
     std::size_t moved = 0;
-    const double min_now = mesh_min();
-    for (std::size_t i = 0;
-         i < order.size() && ((i < options.count && rank[order[i]] < options.below) || rank[order[i]] < options.raise_below);
-         ++i) {
-      for (Index v : mesh.hexes[order[i]]) {
-        if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
-        seen[v] = pass;
-        if (!move_vertex(mesh, inc, v, start, options.surface, options, min_now)) continue;
+    for (std::size_t i = 0; i < order.size() && i < options.count && rank[order[i]] < kQuestionableSJ; ++i) {
+      const Index h = order[i];
+      if (clustered[h]) continue;
+      const std::vector<Index> cluster = cluster_of(h);
+      // The cluster together, and where that gains nothing the worst hex of it alone.
+      for (const std::vector<Index>& targets : {cluster, std::vector<Index>{h}}) {
+        const std::vector<Index> patch = free_vertices_of(targets);
+        if (patch.size() > options.patch_size) continue;
+        if (!opt::move_patch(mesh, inc, targets, patch, start, options, mesh_min())) {
+          if (targets.size() == 1) break;
+          continue;
+        }
         ++moved;
-        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
+        for (Index v : patch)
+          for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
+        break;
       }
     }
-    res.passes = pass;
-    res.moves += moved;
+    res.patch_moves += moved;
     res.min_sj_after = mesh_min();
-    if (options.progress) {
-      std::size_t inverted = 0;
-      for (double x : sj) inverted += x <= 0;
-      options.progress({"worst", pass, static_cast<double>(moved), res.min_sj_after, inverted});
-    }
+    if (options.progress) options.progress({"patch", round + 1, static_cast<double>(moved), res.min_sj_after, 0});
     if (moved == 0) break;
+    single_passes(std::min(options.passes, 10));
   }
   return res;
 }

@@ -1,0 +1,310 @@
+// Joint max–min moves of a patch of vertices: the worst pass's end game (patch.hpp).
+#include "isohex/optimize/patch.hpp"
+
+#include "isohex/optimize/feasibility.hpp"
+#include "isohex/optimize/local_energy.hpp"
+#include "isohex/optimize/slide.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
+#include "isohex/quality/summary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace isohex::opt {
+
+namespace {
+
+// The unknowns of a patch: per vertex 3 (a free or loose vertex: the axes) or 2 (a sliding
+// vertex: its tangent plane), at offsets `off`.
+struct Layout {
+  std::vector<Index> verts;
+  std::vector<std::array<Vec3, 3>> basis;
+  std::vector<int> dims, off;
+  std::vector<Vec3> normal;  // a sliding vertex's surface normal where the model was built
+  std::vector<double> len;   // mean edge length at the vertex
+  int n = 0;
+  [[nodiscard]] int slot(Index v) const {
+    const auto it = std::lower_bound(verts.begin(), verts.end(), v);
+    return it != verts.end() && *it == v ? static_cast<int>(it - verts.begin()) : -1;
+  }
+};
+
+// The terms the patch changes, linearised: row i is b[i] + Σ_j a[i n + j] d_j; mine[i] for
+// the terms of the hex the move is for, frame[i] for a scaled-Jacobian frame (else a ratio term).
+struct Rows {
+  std::vector<double> a, b;
+  std::vector<std::uint8_t> mine, frame;
+};
+
+// What the hexes around the patch are judged by (as move_vertex() judges the hexes around a vertex).
+struct Around {
+  double min_sj = 2, min_ratio = 1, max_edges = 1;
+  int below = 0;
+  bool valid = true;  // no hex valid before is invalid, no edge at the patch shrank too far
+};
+
+Around measure(const HexMesh& mesh, const std::vector<Index>& hexes, const Layout& L, const std::vector<double>* sj_before,
+               const std::vector<Vec3>* start, double shrink) {
+  Around r;
+  for (std::size_t i = 0; i < hexes.size(); ++i) {
+    const Index h = hexes[i];
+    const auto p = mesh.corners(h);
+    const CertifiedQuality c = certified_quality(p);
+    const double q = is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian;
+    r.min_sj = std::min(r.min_sj, q);
+    r.min_ratio = std::min(r.min_ratio, c.ratio_bound);
+    r.max_edges = std::max(r.max_edges, edge_ratio(p));
+    r.below += q < kQuestionableSJ;
+    if (sj_before && q <= 0 && (*sj_before)[i] > 0) r.valid = false;
+    if (!start) continue;
+    for (const auto& e : kHexEdges) {
+      const Index a = mesh.hexes[h][e[0]], b = mesh.hexes[h][e[1]];
+      if ((L.slot(a) >= 0 || L.slot(b) >= 0) &&
+          (p[e[0]] - p[e[1]]).squaredNorm() < shrink * shrink * ((*start)[a] - (*start)[b]).squaredNorm())
+        r.valid = false;
+    }
+  }
+  return r;
+}
+
+// The rows of hex h: its scaled-Jacobian frames that a patch vertex is in (det / product of
+// the column lengths, as frame_values() in worst.cpp) and, where `norm` > 0, those of its 27
+// Bernstein coefficients of det J that a patch vertex changes, over `norm` and weighted
+// kRatioWeight; gradients in the patch's unknowns. A term the patch cannot change is left out:
+// it would cap the LP's bound where no move can help.
+void hex_rows(const HexMesh& mesh, Index h, const Layout& L, double norm, bool mine, Rows& out) {
+  const auto p = mesh.corners(h);
+  std::array<int, 8> slot{};
+  for (int k = 0; k < 8; ++k) slot[k] = L.slot(mesh.hexes[h][k]);
+  const auto push = [&](double value, const std::array<Vec3, 8>& g, bool frame) {
+    out.b.push_back(value);
+    out.mine.push_back(mine);
+    out.frame.push_back(frame);
+    const std::size_t row = out.a.size();
+    out.a.resize(row + static_cast<std::size_t>(L.n), 0.0);
+    for (int k = 0; k < 8; ++k)
+      if (slot[k] >= 0)
+        for (int i = 0; i < L.dims[slot[k]]; ++i)
+          out.a[row + static_cast<std::size_t>(L.off[slot[k]] + i)] += g[k].dot(L.basis[slot[k]][i]);
+  };
+  std::array<Vec3, 8> g;
+  for (int t = 0; t < kFrames; ++t) {
+    bool used = false;
+    for (int k = 0; k < 8; ++k) used = used || (slot[k] >= 0 && !frame_coefficient(t, k).isZero());
+    if (!used) continue;
+    const Mat3 A = frame(p, t, 1.0);
+    const Vec3 l(A.col(0).norm(), A.col(1).norm(), A.col(2).norm());
+    const double prod = l.prod();
+    g.fill(Vec3::Zero());
+    if (!(prod > 0)) {  // a collapsed edge: as Verdict's degenerate hex, below everything
+      push(-2.0, g, true);
+      continue;
+    }
+    const double value = A.determinant() / prod;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3& c = frame_coefficient(t, k);
+      if (slot[k] < 0 || c.isZero()) continue;
+      g[k] = det_gradient(A, c) / prod;
+      for (int j = 0; j < 3; ++j) g[k] -= value * c[j] / (l[j] * l[j]) * A.col(j);
+    }
+    push(value, g, true);
+  }
+  if (!(norm > 0)) return;
+  const std::array<int, 27>& lattice = lattice_frames();
+  std::array<double, 27> b;
+  std::array<std::array<std::array<double, 27>, 3>, 8> gk{};  // per corner, per component
+  for (int n = 0; n < 27; ++n) {
+    const int t = lattice[static_cast<std::size_t>(n)];
+    const Mat3 A = frame(p, t, 1.0);
+    b[n] = kRatioWeight * A.determinant() / norm;
+    for (int k = 0; k < 8; ++k) {
+      if (slot[k] < 0) continue;
+      const Vec3 d = (kRatioWeight / norm) * det_gradient(A, frame_coefficient(t, k));
+      for (int j = 0; j < 3; ++j) gk[k][j][n] = d[j];
+    }
+  }
+  lattice_to_bernstein(b);
+  for (int k = 0; k < 8; ++k)
+    if (slot[k] >= 0)
+      for (int j = 0; j < 3; ++j) lattice_to_bernstein(gk[k][j]);
+  for (int n = 0; n < 27; ++n) {
+    bool moves = false;
+    for (int k = 0; k < 8; ++k) {
+      g[k] = Vec3(gk[k][0][n], gk[k][1][n], gk[k][2][n]);
+      moves = moves || (slot[k] >= 0 && !g[k].isZero());
+    }
+    if (moves) push(b[n], g, false);
+  }
+}
+
+Rows patch_rows(const HexMesh& mesh, const std::vector<Index>& hexes, const std::vector<double>& norms, const Layout& L,
+                const std::vector<Index>& targets) {
+  Rows r;
+  for (std::size_t i = 0; i < hexes.size(); ++i)
+    hex_rows(mesh, hexes[i], L, norms[i], std::binary_search(targets.begin(), targets.end(), hexes[i]), r);
+  return r;
+}
+
+// What the LP does with each row: NaN where the row rises with the bound s, else the level it
+// is held at (f >= level). The hex's own ratio terms rise, and its frames below `sj_floor`
+// (the worst pass's guard); every frame at or above the floor is held at its value or
+// kFrameMargin over the floor (the guard refuses a step that takes a hex below it, and the
+// model is linear); another hex's ratio terms are held at their value below the hex's smallest
+// term (`now`), rise with s between it and kHoldLevel, and are held at kHoldLevel above.
+constexpr double kHoldLevel = 0.3, kFrameMargin = 0.05;
+double row_level(const Rows& r, std::size_t i, double now, double sj_floor) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), f = r.b[i];
+  if (r.frame[i]) return f >= sj_floor ? std::min(f, sj_floor + kFrameMargin) : r.mine[i] ? nan : f;
+  if (r.mine[i]) return nan;
+  return f < now ? f : f < kHoldLevel ? nan : kHoldLevel;
+}
+
+// The smallest of the hex's terms that rise.
+double lowest(const Rows& r, double sj_floor) {
+  double lo = 2.0;
+  for (std::size_t i = 0; i < r.b.size(); ++i)
+    if (r.mine[i] && (!r.frame[i] || r.b[i] < sj_floor)) lo = std::min(lo, r.b[i]);
+  return lo;
+}
+
+// The unknowns of the patch where it stands now (a sliding vertex's tangent plane moves with it).
+void layout_at(const HexMesh& mesh, const Incidence& inc, const BoundarySurface* surface, Layout& L) {
+  L.basis.clear(), L.dims.clear(), L.off.clear(), L.normal.clear(), L.len.clear();
+  L.n = 0;
+  for (Index v : L.verts) {
+    std::array<Vec3, 3> e{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+    Vec3 nrm = Vec3::Zero();
+    int dim = 3;
+    if (surface && surface->role(v) == BoundarySurface::Role::slides) {
+      if (!surface->tangent_normal(v, mesh.points[v], nrm)) {
+        dim = 0;  // no tangent plane: the vertex stays
+      } else {
+        e[0] = (std::abs(nrm.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(nrm).normalized();
+        e[1] = nrm.cross(e[0]);
+        dim = 2;
+      }
+    }
+    L.basis.push_back(e), L.dims.push_back(dim), L.off.push_back(L.n), L.normal.push_back(nrm);
+    L.len.push_back(mean_edge_at(mesh, inc, v));
+    L.n += dim;
+  }
+}
+
+// The LP's rows (a, b, w) from the model: only the rows that can bind within the box go in (a
+// term that rises whose lowest value in it is below the target, which caps the bound; a held
+// one that can fall below its level): the patch's good frames are most of the rows. The held
+// rows are constraints: f_i − held_i >= s·1e-6, which is f_i >= held_i, nearly. The target
+// itself closes the list.
+void lp_rows(const Rows& rows, const std::vector<double>& held, const std::vector<double>& box, double target,
+             std::vector<double>& a, std::vector<double>& b, std::vector<double>& w) {
+  const std::size_t n = box.size();
+  for (std::size_t i = 0; i < rows.b.size(); ++i) {
+    double reach = 0;
+    for (std::size_t j = 0; j < n; ++j) reach += box[j] * std::abs(rows.a[i * n + j]);
+    const bool rises = std::isnan(held[i]);
+    if (rows.b[i] - reach >= (rises ? target : held[i])) continue;
+    a.insert(a.end(), rows.a.begin() + static_cast<std::ptrdiff_t>(i * n),
+             rows.a.begin() + static_cast<std::ptrdiff_t>((i + 1) * n));
+    b.push_back(rises ? rows.b[i] : rows.b[i] - held[i]);
+    w.push_back(rises ? 1.0 : 1e-6);
+  }
+  a.resize(a.size() + n, 0.0);
+  b.push_back(target);
+  w.push_back(1.0);
+}
+
+}  // namespace
+
+bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& targets, const std::vector<Index>& patch,
+                const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min) {
+  if (patch.empty()) return false;
+  const BoundarySurface* surface = options.surface;
+  std::vector<Index> hexes;
+  for (Index v : patch)
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) hexes.push_back(inc.ids[k]);
+  std::sort(hexes.begin(), hexes.end());
+  hexes.erase(std::unique(hexes.begin(), hexes.end()), hexes.end());
+  std::vector<double> norms, sj0;
+  for (Index h : hexes) {
+    const std::array<double, 27> b = jacobian_bernstein(mesh.corners(h));
+    norms.push_back(std::max(0.0, *std::max_element(b.begin(), b.end())));
+    const double q = certified_scaled_jacobian(mesh.corners(h));
+    sj0.push_back(is_degenerate(q) ? -2.0 : q);
+  }
+  Layout L;
+  L.verts = patch;
+  const std::vector<Vec3> x0 = [&] {
+    std::vector<Vec3> x;
+    for (Index v : patch) x.push_back(mesh.points[v]);
+    return x;
+  }();
+  const Around before = measure(mesh, hexes, L, nullptr, nullptr, 0);
+  // The guards of move_vertex(), over the patch's hexes.
+  const double edge_cap = std::max(before.max_edges, before.min_ratio < kPoorJacobianRatio ? options.poor_ratio_edge_limit
+                                                                                           : options.max_edge_ratio);
+  const double ratio_floor = std::min(before.min_ratio, options.ratio_floor);
+  const double sj_floor = std::min(before.min_sj, std::max(options.sj_floor, mesh_min));
+  bool moved = false;
+  double scale = options.step;
+  for (int model = 0; model < options.models; ++model) {
+    layout_at(mesh, inc, surface, L);
+    if (L.n == 0) break;
+    const Rows rows = patch_rows(mesh, hexes, norms, L, targets);
+    const double now = lowest(rows, sj_floor);
+    if (!(now < options.target)) break;
+    std::vector<double> held(rows.b.size());
+    for (std::size_t i = 0; i < rows.b.size(); ++i) held[i] = row_level(rows, i, now, sj_floor);
+    bool gained = false;
+    for (int trial = 0; trial < options.trials && !gained; ++trial, scale *= 0.5) {
+      std::vector<double> box(static_cast<std::size_t>(L.n));
+      for (std::size_t s = 0; s < patch.size(); ++s)
+        for (int i = 0; i < L.dims[s]; ++i) box[static_cast<std::size_t>(L.off[s] + i)] = scale * L.len[s];
+      std::vector<double> a, b, w;
+      lp_rows(rows, held, box, options.target, a, b, w);
+      const MaxMinN r = max_min_affine(L.n, a, b, w, box);
+      if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model
+      const std::vector<Vec3> x = [&] {
+        std::vector<Vec3> y;
+        for (Index v : patch) y.push_back(mesh.points[v]);
+        return y;
+      }();
+      bool placed = true;
+      for (std::size_t s = 0; s < patch.size() && placed; ++s) {
+        Vec3 y = x[s];
+        for (int i = 0; i < L.dims[s]; ++i) y += r.d[static_cast<std::size_t>(L.off[s] + i)] * L.basis[s][i];
+        if (surface && L.dims[s] > 0 && !surface->put_back(patch[s], y, L.normal[s], L.len[s])) placed = false;
+        mesh.points[patch[s]] = y;
+      }
+      bool ok = false;
+      if (placed) {
+        const Around after = measure(mesh, hexes, L, &sj0, &start, options.min_edge_shrink);
+        ok = after.valid && after.below <= before.below && after.min_sj >= sj_floor && after.min_ratio >= ratio_floor &&
+             after.max_edges <= edge_cap;
+        if (ok) {
+          // The hex's terms rise, and no other term falls below its level or below them.
+          const Rows y = patch_rows(mesh, hexes, norms, L, targets);
+          const double raised = lowest(y, sj_floor);
+          ok = raised > now + 1e-9 && y.b.size() == rows.b.size();
+          for (std::size_t i = 0; ok && i < y.b.size(); ++i)
+            if (y.b[i] < (std::isnan(held[i]) ? raised : std::min(held[i], raised))) ok = false;
+        }
+      }
+      if (ok) {
+        gained = moved = true;
+        continue;
+      }
+      for (std::size_t s = 0; s < patch.size(); ++s) mesh.points[patch[s]] = x[s];
+    }
+    if (!gained) break;
+    scale = std::min(4 * scale, options.step);  // the box that worked, doubled (the loop halved it once more)
+  }
+  if (!moved) {
+    for (std::size_t s = 0; s < patch.size(); ++s) mesh.points[patch[s]] = x0[s];
+    return false;
+  }
+  return true;
+}
+
+}  // namespace isohex::opt
