@@ -2,6 +2,7 @@
 #include "isohex/optimize/feasibility.hpp"
 
 #include "isohex/optimize/local_energy.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -104,6 +105,51 @@ MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w
 Vec3 det_gradient(const Mat3& A, const Vec3& c) {
   // adj(A)ᵀ c, written with the cross products of A's columns.
   return c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) + c[2] * A.col(0).cross(A.col(1));
+}
+
+Affine scaled_frame(const Mat3& A, const Vec3& c, bool value_only) {
+  const Vec3 l(A.col(0).norm(), A.col(1).norm(), A.col(2).norm());
+  const double prod = l.prod();
+  Affine f;
+  if (!(prod > 0)) {
+    f.b = -2.0;
+    return f;
+  }
+  f.b = A.determinant() / prod;
+  if (!value_only) {
+    // Column j moves by c_j d: d det = adj(A)ᵀc · d, and each |col j| by c_j col_j·d / |col j|.
+    f.a = det_gradient(A, c) / prod;
+    for (int j = 0; j < 3; ++j) f.a -= f.b * c[j] / (l[j] * l[j]) * A.col(j);
+  }
+  return f;
+}
+
+double bernstein_norm(const std::array<Vec3, 8>& p) {
+  const std::array<double, 27> b = jacobian_bernstein(p);
+  return std::max(0.0, *std::max_element(b.begin(), b.end()));
+}
+
+void ratio_coefficients(const std::array<Vec3, 8>& p, double weight, double norm, const std::array<bool, 8>& corners,
+                        std::array<double, 27>& b, std::array<std::array<Vec3, 27>, 8>* g) {
+  const std::array<int, 27>& lattice = lattice_frames();
+  std::array<std::array<std::array<double, 27>, 3>, 8> gk;  // per corner and component: transformed alike
+  for (int n = 0; n < 27; ++n) {
+    const int t = lattice[static_cast<std::size_t>(n)];
+    const Mat3 A = frame(p, t, 1.0);
+    b[n] = weight * A.determinant() / norm;
+    for (int k = 0; g && k < 8; ++k) {
+      if (!corners[k]) continue;
+      const Vec3 d = (weight / norm) * det_gradient(A, frame_coefficient(t, k));
+      for (int j = 0; j < 3; ++j) gk[k][j][n] = d[j];
+    }
+  }
+  lattice_to_bernstein(b);
+  if (!g) return;
+  for (int k = 0; k < 8; ++k) {
+    if (!corners[k]) continue;
+    for (int j = 0; j < 3; ++j) lattice_to_bernstein(gk[k][j]);
+    for (int n = 0; n < 27; ++n) (*g)[k][n] = Vec3(gk[k][0][n], gk[k][1][n], gk[k][2][n]);
+  }
 }
 
 std::vector<Affine> vertex_frames(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,

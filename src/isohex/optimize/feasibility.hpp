@@ -14,6 +14,7 @@
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 
+#include <array>
 #include <vector>
 
 namespace isohex::opt {
@@ -48,6 +49,23 @@ MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<do
 /// d det(A + d cᵀ)/dd: the gradient of a frame's determinant when one of its corners moves by d
 /// and c is that corner's coefficient in the frame (frame_coefficient()).
 Vec3 det_gradient(const Mat3& A, const Vec3& c);
+
+/// Verdict's scaled Jacobian of frame A (its determinant over the product of its column
+/// lengths) as an affine function of the place of a corner whose coefficient in the frame is c
+/// (the gradient left zero with `value_only`); −2 for a collapsed column, as Verdict's
+/// degenerate hex, below everything.
+Affine scaled_frame(const Mat3& A, const Vec3& c, bool value_only = false);
+
+/// The largest Bernstein coefficient of det J of hex p, or 0 when none is positive: the norm of
+/// the worst pass's ratio terms while a vertex (or a patch) moves.
+double bernstein_norm(const std::array<Vec3, 8>& p);
+
+/// The worst pass's ratio terms of hex p: `weight` × det J's 27 Bernstein coefficients over
+/// `norm` in `b`, and, where g is not null, their gradients in the place of each corner k with
+/// corners[k] set in (*g)[k] (each lattice determinant is affine in one corner: matrix
+/// determinant lemma; the coefficients are fixed combinations of them).
+void ratio_coefficients(const std::array<Vec3, 8>& p, double weight, double norm, const std::array<bool, 8>& corners,
+                        std::array<double, 27>& b, std::array<std::array<Vec3, 27>, 8>* g);
 
 /// The normalised determinants of the frames that see vertex v (each incident hex, the corner
 /// frames using v and the centre frame) as affine functions of v's displacement. With `fixed`,

@@ -45,8 +45,11 @@ struct Around {
   bool valid = true;  // no hex valid before is invalid, no edge at the patch shrank too far
 };
 
+// With `sj_out`, each hex's certified scaled Jacobian (−2 where degenerate) too; with
+// `sj_before`, a hex valid there and not now makes it invalid; with `start`, so does an edge at
+// the patch shorter than `shrink` times its length there.
 Around measure(const HexMesh& mesh, const std::vector<Index>& hexes, const Layout& L, const std::vector<double>* sj_before,
-               const std::vector<Vec3>* start, double shrink) {
+               const std::vector<Vec3>* start, double shrink, std::vector<double>* sj_out = nullptr) {
   Around r;
   for (std::size_t i = 0; i < hexes.size(); ++i) {
     const Index h = hexes[i];
@@ -57,6 +60,7 @@ Around measure(const HexMesh& mesh, const std::vector<Index>& hexes, const Layou
     r.min_ratio = std::min(r.min_ratio, c.ratio_bound);
     r.max_edges = std::max(r.max_edges, edge_ratio(p));
     r.below += q < kQuestionableSJ;
+    if (sj_out) sj_out->push_back(q);
     if (sj_before && q <= 0 && (*sj_before)[i] > 0) r.valid = false;
     if (!start) continue;
     for (const auto& e : kHexEdges) {
@@ -69,8 +73,7 @@ Around measure(const HexMesh& mesh, const std::vector<Index>& hexes, const Layou
   return r;
 }
 
-// The rows of hex h: its scaled-Jacobian frames that a patch vertex is in (det / product of
-// the column lengths, as frame_values() in worst.cpp) and, where `norm` > 0, those of its 27
+// The rows of hex h: its scaled-Jacobian frames that a patch vertex is in (scaled_frame()) and, where `norm` > 0, those of its 27
 // Bernstein coefficients of det J that a patch vertex changes, over `norm` and weighted
 // kRatioWeight; gradients in the patch's unknowns. A term the patch cannot change is left out:
 // it would cap the LP's bound where no move can help.
@@ -95,45 +98,25 @@ void hex_rows(const HexMesh& mesh, Index h, const Layout& L, double norm, bool m
     for (int k = 0; k < 8; ++k) used = used || (slot[k] >= 0 && !frame_coefficient(t, k).isZero());
     if (!used) continue;
     const Mat3 A = frame(p, t, 1.0);
-    const Vec3 l(A.col(0).norm(), A.col(1).norm(), A.col(2).norm());
-    const double prod = l.prod();
-    g.fill(Vec3::Zero());
-    if (!(prod > 0)) {  // a collapsed edge: as Verdict's degenerate hex, below everything
-      push(-2.0, g, true);
-      continue;
-    }
-    const double value = A.determinant() / prod;
+    double value = 0;
     for (int k = 0; k < 8; ++k) {
-      const Vec3& c = frame_coefficient(t, k);
-      if (slot[k] < 0 || c.isZero()) continue;
-      g[k] = det_gradient(A, c) / prod;
-      for (int j = 0; j < 3; ++j) g[k] -= value * c[j] / (l[j] * l[j]) * A.col(j);
+      const Affine f = scaled_frame(A, frame_coefficient(t, k), slot[k] < 0);
+      value = f.b;
+      g[k] = f.a;
     }
     push(value, g, true);
   }
   if (!(norm > 0)) return;
-  const std::array<int, 27>& lattice = lattice_frames();
+  std::array<bool, 8> corners;
+  for (int k = 0; k < 8; ++k) corners[k] = slot[k] >= 0;
   std::array<double, 27> b;
-  std::array<std::array<std::array<double, 27>, 3>, 8> gk{};  // per corner, per component
-  for (int n = 0; n < 27; ++n) {
-    const int t = lattice[static_cast<std::size_t>(n)];
-    const Mat3 A = frame(p, t, 1.0);
-    b[n] = kRatioWeight * A.determinant() / norm;
-    for (int k = 0; k < 8; ++k) {
-      if (slot[k] < 0) continue;
-      const Vec3 d = (kRatioWeight / norm) * det_gradient(A, frame_coefficient(t, k));
-      for (int j = 0; j < 3; ++j) gk[k][j][n] = d[j];
-    }
-  }
-  lattice_to_bernstein(b);
-  for (int k = 0; k < 8; ++k)
-    if (slot[k] >= 0)
-      for (int j = 0; j < 3; ++j) lattice_to_bernstein(gk[k][j]);
+  std::array<std::array<Vec3, 27>, 8> gk;
+  ratio_coefficients(p, kRatioWeight, norm, corners, b, &gk);
   for (int n = 0; n < 27; ++n) {
     bool moves = false;
     for (int k = 0; k < 8; ++k) {
-      g[k] = Vec3(gk[k][0][n], gk[k][1][n], gk[k][2][n]);
-      moves = moves || (slot[k] >= 0 && !g[k].isZero());
+      g[k] = corners[k] ? gk[k][n] : Vec3::Zero();
+      moves = moves || !g[k].isZero();
     }
     if (moves) push(b[n], g, false);
   }
@@ -227,20 +210,10 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
   std::sort(hexes.begin(), hexes.end());
   hexes.erase(std::unique(hexes.begin(), hexes.end()), hexes.end());
   std::vector<double> norms, sj0;
-  for (Index h : hexes) {
-    const std::array<double, 27> b = jacobian_bernstein(mesh.corners(h));
-    norms.push_back(std::max(0.0, *std::max_element(b.begin(), b.end())));
-    const double q = certified_scaled_jacobian(mesh.corners(h));
-    sj0.push_back(is_degenerate(q) ? -2.0 : q);
-  }
+  for (Index h : hexes) norms.push_back(bernstein_norm(mesh.corners(h)));
   Layout L;
   L.verts = patch;
-  const std::vector<Vec3> x0 = [&] {
-    std::vector<Vec3> x;
-    for (Index v : patch) x.push_back(mesh.points[v]);
-    return x;
-  }();
-  const Around before = measure(mesh, hexes, L, nullptr, nullptr, 0);
+  const Around before = measure(mesh, hexes, L, nullptr, nullptr, 0, &sj0);
   // The guards of move_vertex(), over the patch's hexes.
   const double edge_cap = std::max(before.max_edges, before.min_ratio < kPoorJacobianRatio ? options.poor_ratio_edge_limit
                                                                                            : options.max_edge_ratio);
@@ -300,11 +273,7 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
     if (!gained) break;
     scale = std::min(4 * scale, options.step);  // the box that worked, doubled (the loop halved it once more)
   }
-  if (!moved) {
-    for (std::size_t s = 0; s < patch.size(); ++s) mesh.points[patch[s]] = x0[s];
-    return false;
-  }
-  return true;
+  return moved;  // a step not taken was undone: without a gain the patch is where it was
 }
 
 }  // namespace isohex::opt

@@ -76,21 +76,18 @@ using opt::kRatioWeight;
 // during one move of v.
 std::vector<double> ratio_norms(const HexMesh& mesh, const Incidence& inc, Index v) {
   std::vector<double> m;
-  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
-    const std::array<double, 27> b = jacobian_bernstein(mesh.corners(inc.ids[i]));
-    m.push_back(std::max(0.0, *std::max_element(b.begin(), b.end())));
-  }
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) m.push_back(opt::bernstein_norm(mesh.corners(inc.ids[i])));
   return m;
 }
 
 // The Bernstein coefficients of det J of each hex around v over its norm, as affine functions
-// of v's place: each lattice determinant is affine in one vertex (matrix determinant lemma)
-// and the coefficients are fixed combinations of them. Their minimum bounds the hex's
-// jacobian ratio from below, so a max–min move on them raises the element's interior, not only
-// Verdict's nine samples.
+// of v's place (opt::ratio_coefficients). Their minimum bounds the hex's jacobian ratio from
+// below, so a max–min move on them raises the element's interior, not only Verdict's nine
+// samples.
 void ratio_terms(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool value_only,
                  const std::vector<double>& norms, std::vector<opt::Affine>& out) {
-  const std::array<int, 27>& lattice = opt::lattice_frames();
+  std::array<double, 27> b;
+  std::array<std::array<Vec3, 27>, 8> g;
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const double m = norms[static_cast<std::size_t>(i - inc.offsets[v])];
     if (!(m > 0)) continue;
@@ -99,25 +96,17 @@ void ratio_terms(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
     int k = 0;
     while (mesh.hexes[h][k] != v) ++k;
     p[k] = x;
-    std::array<double, 27> b, gx, gy, gz;  // values and gradients, transformed alike
-    for (int n = 0; n < 27; ++n) {
-      const int t = lattice[static_cast<std::size_t>(n)];
-      const opt::Mat3 A = opt::frame(p, t, 1.0);
-      b[n] = kRatioWeight * A.determinant() / m;
-      const Vec3 g = value_only ? Vec3::Zero() : Vec3((kRatioWeight / m) * opt::det_gradient(A, opt::frame_coefficient(t, k)));
-      gx[n] = g[0], gy[n] = g[1], gz[n] = g[2];
-    }
-    lattice_to_bernstein(b);
-    if (!value_only) lattice_to_bernstein(gx), lattice_to_bernstein(gy), lattice_to_bernstein(gz);
-    for (int n = 0; n < 27; ++n) out.push_back({Vec3(gx[n], gy[n], gz[n]), b[n]});
+    std::array<bool, 8> corner{};
+    corner[k] = true;
+    opt::ratio_coefficients(p, kRatioWeight, m, corner, b, value_only ? nullptr : &g);
+    for (int n = 0; n < 27; ++n) out.push_back({value_only ? Vec3::Zero() : g[k][n], b[n]});
   }
 }
 
 // The scaled Jacobians of the frames (of the hexes around v) that v's position changes, each
-// as its value and gradient in that position: det[a b c] / (|a| |b| |c|), the columns of
-// opt::frame(). Verdict's hex value is the minimum of these and of the frames v is not in.
-// With `value_only`, the gradients are left zero; with `norms` (ratio_norms()), ratio_terms()
-// come too.
+// as its value and gradient in that position (opt::scaled_frame). Verdict's hex value is the
+// minimum of these and of the frames v is not in. With `value_only`, the gradients are left
+// zero; with `norms` (ratio_norms()), ratio_terms() come too.
 std::vector<opt::Affine> frame_values(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x,
                                       bool value_only, const std::vector<double>* norms) {
   std::vector<opt::Affine> out;
@@ -130,23 +119,7 @@ std::vector<opt::Affine> frame_values(const HexMesh& mesh, const Incidence& inc,
     p[k] = x;
     for (int t = 0; t < opt::kFrames; ++t) {
       const Vec3& c = opt::frame_coefficient(t, k);
-      if (c.isZero()) continue;
-      const opt::Mat3 A = opt::frame(p, t, 1.0);
-      const Vec3 l(A.col(0).norm(), A.col(1).norm(), A.col(2).norm());
-      const double prod = l.prod();
-      opt::Affine f;
-      if (!(prod > 0)) {  // a collapsed edge: as Verdict's degenerate hex, below everything
-        f.b = -2.0;
-        out.push_back(f);
-        continue;
-      }
-      f.b = A.determinant() / prod;
-      if (!value_only) {
-        // Column j moves by c_j d: d det = adj(A)ᵀc · d, and each |col j| by c_j col_j·d / |col j|.
-        f.a = opt::det_gradient(A, c) / prod;
-        for (int j = 0; j < 3; ++j) f.a -= f.b * c[j] / (l[j] * l[j]) * A.col(j);
-      }
-      out.push_back(f);
+      if (!c.isZero()) out.push_back(opt::scaled_frame(opt::frame(p, t, 1.0), c, value_only));
     }
   }
   return out;
@@ -339,9 +312,9 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     }
   };
   single_passes(options.passes);
-  // The end game: the hexes still below 0.2 by rank, each with its free vertices moved together,
-  // then (where that gains nothing) with those of the hexes sharing a vertex with it; the single
-  // moves again after a round that moved something.
+  // The end game: each cluster of hexes still below 0.2 by rank with the free vertices of its
+  // hexes moved together, or where that gains nothing those of its worst hex; the single moves
+  // again after a round that moved something.
   const auto free_vertices_of = [&](const std::vector<Index>& hexes) {
     std::vector<Index> p;
     for (Index h : hexes)
@@ -376,18 +349,15 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       if (clustered[h]) continue;
       const std::vector<Index> cluster = cluster_of(h);
       // The cluster together, and where that gains nothing the worst hex of it alone.
-      for (const std::vector<Index>& targets : {cluster, std::vector<Index>{h}}) {
+      const auto try_patch = [&](const std::vector<Index>& targets) {
         const std::vector<Index> patch = free_vertices_of(targets);
-        if (patch.size() > options.patch_size) continue;
-        if (!opt::move_patch(mesh, inc, targets, patch, start, options, mesh_min())) {
-          if (targets.size() == 1) break;
-          continue;
-        }
-        ++moved;
+        if (patch.size() > options.patch_size || !opt::move_patch(mesh, inc, targets, patch, start, options, mesh_min()))
+          return false;
         for (Index v : patch)
           for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
-        break;
-      }
+        return true;
+      };
+      moved += try_patch(cluster) || (cluster.size() > 1 && try_patch({h}));
     }
     res.patch_moves += moved;
     res.min_sj_after = mesh_min();
