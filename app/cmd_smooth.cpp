@@ -40,6 +40,7 @@ struct Args {
   double tol = 1e-5, margin = 0.05;
   double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
   int patch_rounds = WorstOptions{}.patch_rounds;  ///< --patch-rounds
+  int worst_passes = WorstOptions{}.passes;        ///< --worst-passes
   int* threads = nullptr;
 };
 
@@ -131,6 +132,7 @@ void run(const Args& a) {
   }
   o.shape_options.tol = a.tol;
   o.worst_options.patch_rounds = a.patch_rounds;
+  o.worst_options.passes = a.worst_passes;
   o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
   o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
   report.update(run_optimisation(mesh, fixed, o));
@@ -191,7 +193,8 @@ void register_smooth(CLI::App& app) {
   cmd->footer(
       "Examples:\n"
       "  isohex smooth tangled.vtk -o smooth.vtu --untangle --json smooth.json\n"
-      "  isohex smooth pillowed.vtu -o out.vtu --untangle --boundary slide --surface-band 0.3 --patch-rounds 10");
+      "  isohex smooth pillowed.vtu -o out.vtu --untangle --boundary slide --surface-band 0.3 --patch-rounds 10\n"
+      "  isohex smooth block.mesh -o out.vtu --untangle --worst-passes 100 --json r.json   # r.json: worst.proven");
   cmd->add_option("mesh", a->in, "Input hex mesh (.vtk .vtu .mesh .inp)")->required();
   cmd->add_option("-o,--output", a->out, "Output mesh")->required();
   cmd->add_flag("--untangle", a->untangle, "First make every hex valid (scaled Jacobian >= --margin where possible)");
@@ -230,6 +233,10 @@ void register_smooth(CLI::App& app) {
                   "Rounds of joint moves that end the worst-element pass: the free vertices of each cluster of hexes "
                   "still below 0.2 move together, where single moves stall (default 5; 0: off)")
       ->check(CLI::Range(0, 100));
+  cmd->add_option("--worst-passes", a->worst_passes,
+                  "Passes of single-vertex max-min moves of the worst-element pass; it stops earlier when a pass "
+                  "moves nothing (default 30)")
+      ->check(CLI::Range(1, 10000));
   cmd->add_option("--json", a->json, "Write a JSON report (before/after quality, stage results)");
   cmd->add_flag("--skip-non-hex", a->skip_non_hex, "Drop non-hexahedral cells instead of failing");
   a->threads = add_threads_option(cmd);

@@ -11,6 +11,7 @@
 #include "isohex/sheets/pillow.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -137,6 +138,18 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
                   {"min_sj_before", w.min_sj_before},
                   {"min_sj_after", w.min_sj_after},
                   {"seconds", r.worst_seconds}};
+    // The hexes no placement of the free vertices lifts to 0.2, proven (find_quality_bounds()).
+    auto& proven = j["worst"]["proven"] = nlohmann::json::array();
+    for (const QualityBound& b : w.proven)
+      proven.push_back({{"kind", to_string(b.kind)}, {"vertex", b.vertex}, {"free", b.free}, {"bound", b.bound},
+                        {"hexes", b.hexes}});
+    for (std::size_t i = 0; i < w.proven.size() && i < 5; ++i) {
+      const QualityBound& b = w.proven[i];
+      fmt::print("  proven with the fixed vertices: one of hexes {} stays at or below {:.4f} ({} at vertex {}{})\n",
+                 fmt::join(b.hexes, ","), b.bound, to_string(b.kind), b.vertex,
+                 b.free >= 0 ? fmt::format(", free edge to {}", b.free) : "");
+    }
+    if (w.proven.size() > 5) fmt::print("  ... and {} more proofs (JSON: worst.proven)\n", w.proven.size() - 5);
   }
   return j;
 }

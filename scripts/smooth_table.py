@@ -3,7 +3,8 @@
 meshes), measured as a solver sees them (issue 15): per mesh and boundary setting, hexes not
 certified valid inside and with det J <= 0 at a Gauss point, the smallest jacobian ratio (with
 the count below 0.1), the largest edge ratio, below 0.2 / inverted by the scaled Jacobian, and
-the hexes the untangler proves cannot all be valid with the fixed vertices (`untangle.infeasible`).
+the hexes the untangler proves cannot all be valid with the fixed vertices (`untangle.infeasible`)
+and the sets of hexes the worst pass proves cannot all reach 0.2 (`worst.proven`, with the bound).
 
     /usr/bin/python3 scripts/smooth_table.py --cli build/bin/isohex --data ../shared/data [--only NAME,...]
 
@@ -58,6 +59,8 @@ def main():
             m = inside_measures(args.cli, out, tmp)
             q = r["after"]
             proofs = r.get("untangle", {}).get("infeasible", [])
+            # Sets of hexes that cannot all reach 0.2 with the fixed vertices (worst.proven).
+            proofs += [dict(p, kind=f"{p['kind']} ≤ {p['bound']:.4f}") for p in r.get("worst", {}).get("proven", [])]
             impossible = ", ".join(f"{p['kind']} {p['hexes']}" for p in proofs[:3]) + (" …" if len(proofs) > 3 else "")
             print(f"| {name} | {label} | {r['hexes']:,} | {m['invalid']:,} / {m['gauss']:,} | {m['ratio']:.3f} "
                   f"({m['poor']:,}) | {m['edge_ratio']:.1f} | {q['below_0.2']:,} / {q['inverted']:,} | {q['min']:.3f} | "

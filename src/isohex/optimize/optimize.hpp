@@ -145,6 +145,33 @@ const char* to_string(InfeasibleSet::Kind kind);
 /// Deterministic, ordered by kind, then vertex.
 std::vector<InfeasibleSet> find_infeasible(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed);
 
+/// A proof that some hexes cannot all reach a scaled Jacobian level with the fixed vertices held.
+struct QualityBound {
+  enum class Kind {
+    fixed_frame,     ///< a frame (a corner, or the centre of an all-fixed hex) of fixed vertices only: its value
+    edge_direction,  ///< the corner frames at fixed `vertex` whose only free vertex is `free`: each is
+                     ///< n_i · u with u the unit direction of the edge to `free` and n_i the cross product of the
+                     ///< frame's two fixed unit edges, so the best their smallest can be is the distance from 0 to
+                     ///< the convex hull of the n_i (then u points at the hull's nearest point)
+  };
+  Kind kind = Kind::fixed_frame;
+  Index vertex = -1;         ///< the frame's corner (fixed); -1 for a centre frame
+  Index free = -1;           ///< edge_direction: the free end of the edge
+  double bound = 0;          ///< the largest value the smallest of these frames can take (<= 0: none valid)
+  std::vector<Index> hexes;  ///< at least one of these hexes stays at or below `bound` (ascending)
+};
+/// "fixed_frame" / "edge_direction".
+const char* to_string(QualityBound::Kind kind);
+
+/// Proofs that some hexes cannot all reach a scaled Jacobian of `level` with `fixed` held, each
+/// with the best its hexes' smallest value can be (bound < level): frames of fixed vertices only,
+/// and fixed corners whose frames share one free edge (a boundary vertex of valence 3 whose
+/// boundary quads meet at a sharp angle: ECR block_in, 0.197 at best). A relaxation: the frames
+/// of a set are judged alone, so a set whose bound is above `level` may still be impossible.
+/// Deterministic, ordered by kind, then vertex, then free vertex.
+std::vector<QualityBound> find_quality_bounds(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
+                                              double level = 0.2);
+
 /// What the untangler did.
 struct UntangleResult {
   int iterations = 0;
@@ -258,6 +285,10 @@ struct WorstResult {
   std::size_t moves = 0;
   std::size_t patch_moves = 0;  ///< joint moves of patches (WorstOptions::patch_rounds)
   double min_sj_before = 0, min_sj_after = 0;
+  /// With fixed vertices and hexes still below 0.2 at the end: find_quality_bounds() at 0.2, the
+  /// sets of hexes that no placement of the free vertices lifts all to 0.2. A hex below 0.2 in
+  /// none of them is the pass's own shortfall.
+  std::vector<QualityBound> proven;
 };
 
 /// Raises the lowest scaled Jacobians in place; the mesh minimum never decreases.

@@ -35,7 +35,8 @@ struct Layout {
 // the terms of the hex the move is for, frame[i] for a scaled-Jacobian frame (else a ratio term).
 struct Rows {
   std::vector<double> a, b;
-  std::vector<std::uint8_t> mine, frame;
+  std::vector<std::uint8_t> mine, frame, cap;  // cap: a coefficient negated (held below a level)
+  std::vector<int> hex;                         // the row's hex, an index into the patch's hexes
 };
 
 // What the hexes around the patch are judged by (as move_vertex() judges the hexes around a vertex).
@@ -77,20 +78,22 @@ Around measure(const HexMesh& mesh, const std::vector<Index>& hexes, const Layou
 // Bernstein coefficients of det J that a patch vertex changes, over `norm` and weighted
 // kRatioWeight; gradients in the patch's unknowns. A term the patch cannot change is left out:
 // it would cap the LP's bound where no move can help.
-void hex_rows(const HexMesh& mesh, Index h, const Layout& L, double norm, bool mine, Rows& out) {
+void hex_rows(const HexMesh& mesh, Index h, int index, const Layout& L, double norm, bool mine, bool caps, Rows& out) {
   const auto p = mesh.corners(h);
   std::array<int, 8> slot{};
   for (int k = 0; k < 8; ++k) slot[k] = L.slot(mesh.hexes[h][k]);
-  const auto push = [&](double value, const std::array<Vec3, 8>& g, bool frame) {
-    out.b.push_back(value);
-    out.mine.push_back(mine);
+  const auto push = [&](double value, const std::array<Vec3, 8>& g, bool frame, double sign = 1) {
+    out.b.push_back(sign * value);
+    out.mine.push_back(mine && sign > 0);
     out.frame.push_back(frame);
+    out.cap.push_back(sign < 0);
+    out.hex.push_back(index);
     const std::size_t row = out.a.size();
     out.a.resize(row + static_cast<std::size_t>(L.n), 0.0);
     for (int k = 0; k < 8; ++k)
       if (slot[k] >= 0)
         for (int i = 0; i < L.dims[slot[k]]; ++i)
-          out.a[row + static_cast<std::size_t>(L.off[slot[k]] + i)] += g[k].dot(L.basis[slot[k]][i]);
+          out.a[row + static_cast<std::size_t>(L.off[slot[k]] + i)] += sign * g[k].dot(L.basis[slot[k]][i]);
   };
   std::array<Vec3, 8> g;
   for (int t = 0; t < kFrames; ++t) {
@@ -118,15 +121,19 @@ void hex_rows(const HexMesh& mesh, Index h, const Layout& L, double norm, bool m
       g[k] = corners[k] ? gk[k][n] : Vec3::Zero();
       moves = moves || !g[k].isZero();
     }
-    if (moves) push(b[n], g, false);
+    if (!moves) continue;
+    push(b[n], g, false);
+    // The ratio bound is min over max: near the ratio floor, a coefficient rising lowers it as
+    // surely as the smallest falling (hold_levels() says how far it may rise).
+    if (caps) push(b[n], g, false, -1);
   }
 }
 
-Rows patch_rows(const HexMesh& mesh, const std::vector<Index>& hexes, const std::vector<double>& norms, const Layout& L,
-                const std::vector<Index>& targets) {
+Rows patch_rows(const HexMesh& mesh, const std::vector<Index>& hexes, const std::vector<double>& norms,
+                const std::vector<std::uint8_t>& caps, const Layout& L, const std::vector<Index>& targets) {
   Rows r;
   for (std::size_t i = 0; i < hexes.size(); ++i)
-    hex_rows(mesh, hexes[i], L, norms[i], std::binary_search(targets.begin(), targets.end(), hexes[i]), r);
+    hex_rows(mesh, hexes[i], static_cast<int>(i), L, norms[i], std::binary_search(targets.begin(), targets.end(), hexes[i]), caps[i] != 0, r);
   return r;
 }
 
@@ -135,20 +142,49 @@ Rows patch_rows(const HexMesh& mesh, const std::vector<Index>& hexes, const std:
 // (the worst pass's guard); every frame at or above the floor is held at its value or
 // kFrameMargin over the floor (the guard refuses a step that takes a hex below it, and the
 // model is linear); another hex's ratio terms are held at their value below the hex's smallest
-// term (`now`), rise with s between it and kHoldLevel, and are held at kHoldLevel above.
-constexpr double kHoldLevel = 0.3, kFrameMargin = 0.05;
-double row_level(const Rows& r, std::size_t i, double now, double sj_floor) {
+// term (`now`), rise with s between it and kHoldLevel, and are held at kHoldLevel above. A
+// ratio term at or above the guard's ratio floor (weighted: `ratio_level`) is held there too,
+// the hex's own ones included: the LP let ratios at the floor fall to s and the guard refused
+// every step (ECR block_in, its ratios pressed to 0.200 by the single moves).
+constexpr double kHoldLevel = 0.3, kFrameMargin = 0.05, kInfinite = std::numeric_limits<double>::infinity();
+double row_level(const Rows& r, std::size_t i, double now, double sj_floor, double rise, double ratio_level) {
   const double nan = std::numeric_limits<double>::quiet_NaN(), f = r.b[i];
-  if (r.frame[i]) return f >= sj_floor ? std::min(f, sj_floor + kFrameMargin) : r.mine[i] ? nan : f;
-  if (r.mine[i]) return nan;
-  return f < now ? f : f < kHoldLevel ? nan : kHoldLevel;
+  if (r.frame[i]) return r.mine[i] && f < rise ? nan : f >= sj_floor ? std::min(f, sj_floor + kFrameMargin) : f;
+  const double level = r.mine[i] ? nan : f < now ? f : f < kHoldLevel ? nan : kHoldLevel;
+  if (f < ratio_level || ratio_level <= now * (1 + 1e-6)) return level;  // rising, it stays above the floor
+  const double guard = std::min(f, ratio_level + kFrameMargin);
+  return std::isnan(level) ? guard : std::max(level, guard);
 }
 
-// The smallest of the hex's terms that rise.
-double lowest(const Rows& r, double sj_floor) {
+// Every row's level (row_level()); a cap row's: its coefficient may rise while the smallest of
+// its hex's coefficients (held at its level, or at s >= now where it rises, or not changed by
+// the patch) over it stays at or above the ratio floor. `ratios`: each hex's ratio bound when
+// the move began.
+std::vector<double> hold_levels(const Rows& rows, const std::vector<double>& ratios, double now, double sj_floor,
+                                double rise, double ratio_floor, bool guarded) {
+  std::vector<double> held(rows.b.size(), 0.0), least(ratios.size());
+  for (std::size_t h = 0; h < ratios.size(); ++h) least[h] = kRatioWeight * ratios[h];
+  for (std::size_t i = 0; i < rows.b.size(); ++i) {
+    if (rows.cap[i]) continue;
+    held[i] = row_level(rows, i, now, sj_floor, rise, guarded ? kRatioWeight * ratio_floor : kInfinite);
+    if (!rows.frame[i]) {
+      double& l = least[static_cast<std::size_t>(rows.hex[i])];
+      l = std::min(l, std::isnan(held[i]) ? now : std::min(held[i], rows.b[i]));
+    }
+  }
+  for (std::size_t i = 0; i < rows.b.size(); ++i)
+    if (rows.cap[i])  // −b >= −least / floor; 2e-6 of room for the s·1e-6 of a held row
+      held[i] = std::min(rows.b[i], -least[static_cast<std::size_t>(rows.hex[i])] / ratio_floor) - kRatioWeight * 1e-6;
+  return held;
+}
+
+// The smallest of the hex's terms that rise, as the model `terms` chose them (its frames below
+// `sj_floor`, its ratio terms), at their values in `values` (rows of the same hexes): a frame that
+// the move takes over the floor still counts.
+double lowest(const Rows& terms, const Rows& values, double rise) {
   double lo = 2.0;
-  for (std::size_t i = 0; i < r.b.size(); ++i)
-    if (r.mine[i] && (!r.frame[i] || r.b[i] < sj_floor)) lo = std::min(lo, r.b[i]);
+  for (std::size_t i = 0; i < terms.b.size(); ++i)
+    if (terms.mine[i] && (!terms.frame[i] || terms.b[i] < rise)) lo = std::min(lo, values.b[i]);
   return lo;
 }
 
@@ -201,7 +237,7 @@ void lp_rows(const Rows& rows, const std::vector<double>& held, const std::vecto
 }  // namespace
 
 bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& targets, const std::vector<Index>& patch,
-                const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min) {
+                const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min, bool guarded) {
   if (patch.empty()) return false;
   const BoundarySurface* surface = options.surface;
   std::vector<Index> hexes;
@@ -209,8 +245,11 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
     for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) hexes.push_back(inc.ids[k]);
   std::sort(hexes.begin(), hexes.end());
   hexes.erase(std::unique(hexes.begin(), hexes.end()), hexes.end());
-  std::vector<double> norms, sj0;
-  for (Index h : hexes) norms.push_back(bernstein_norm(mesh.corners(h)));
+  std::vector<double> norms, sj0, ratios;
+  for (Index h : hexes) {
+    norms.push_back(bernstein_norm(mesh.corners(h)));
+    ratios.push_back(jacobian_ratio_bound(mesh.corners(h)));
+  }
   Layout L;
   L.verts = patch;
   const Around before = measure(mesh, hexes, L, nullptr, nullptr, 0, &sj0);
@@ -219,16 +258,30 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
                                                                                            : options.max_edge_ratio);
   const double ratio_floor = std::min(before.min_ratio, options.ratio_floor);
   const double sj_floor = std::min(before.min_sj, std::max(options.sj_floor, mesh_min));
+  // The hexes' own frames below this rise; one at the patch's minimum too (were it held at the
+  // floor, the LP would raise the hex's ratio terms instead).
+  const double rise = guarded ? std::max(sj_floor, options.sj_floor) : sj_floor;
+  // The other hexes near the ratio floor hold their largest coefficients down (caps), where the
+  // floor is not the targets' own ratio (then their ratio terms rise, the others' with them):
+  // the caps are the stricter the more a hex's smallest may fall, and blocked the bone's joint
+  // moves (tests/data/bone_cluster.txt) when they held every hex within twice the floor.
+  std::vector<std::uint8_t> caps(hexes.size()), mine(hexes.size());
+  double mine_ratio = 1;
+  for (std::size_t i = 0; i < hexes.size(); ++i) {
+    mine[i] = std::binary_search(targets.begin(), targets.end(), hexes[i]);
+    if (mine[i]) mine_ratio = std::min(mine_ratio, ratios[i]);
+  }
+  for (std::size_t i = 0; i < hexes.size(); ++i)
+    caps[i] = guarded && !mine[i] && ratios[i] < 1.25 * ratio_floor && ratio_floor < mine_ratio * (1 - 1e-6);
   bool moved = false;
   double scale = options.step;
   for (int model = 0; model < options.models; ++model) {
     layout_at(mesh, inc, surface, L);
     if (L.n == 0) break;
-    const Rows rows = patch_rows(mesh, hexes, norms, L, targets);
-    const double now = lowest(rows, sj_floor);
+    const Rows rows = patch_rows(mesh, hexes, norms, caps, L, targets);
+    const double now = lowest(rows, rows, rise);
     if (!(now < options.target)) break;
-    std::vector<double> held(rows.b.size());
-    for (std::size_t i = 0; i < rows.b.size(); ++i) held[i] = row_level(rows, i, now, sj_floor);
+    const std::vector<double> held = hold_levels(rows, ratios, now, sj_floor, rise, ratio_floor, guarded);
     bool gained = false;
     for (int trial = 0; trial < options.trials && !gained; ++trial, scale *= 0.5) {
       std::vector<double> box(static_cast<std::size_t>(L.n));
@@ -256,12 +309,15 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
         ok = after.valid && after.below <= before.below && after.min_sj >= sj_floor && after.min_ratio >= ratio_floor &&
              after.max_edges <= edge_cap;
         if (ok) {
-          // The hex's terms rise, and no other term falls below its level or below them.
-          const Rows y = patch_rows(mesh, hexes, norms, L, targets);
-          const double raised = lowest(y, sj_floor);
-          ok = raised > now + 1e-9 && y.b.size() == rows.b.size();
+          // The hex's terms rise, and no other term falls below its level or below them (the caps
+          // are the ratio bound's, checked above on the true values).
+          const Rows y = patch_rows(mesh, hexes, norms, caps, L, targets);
+          ok = y.b.size() == rows.b.size();
+          const double raised = ok ? lowest(rows, y, rise) : now;
+          ok = ok && raised > now + 1e-9;
           for (std::size_t i = 0; ok && i < y.b.size(); ++i)
-            if (y.b[i] < (std::isnan(held[i]) ? raised : std::min(held[i], raised))) ok = false;
+            if (!rows.cap[i] && y.b[i] < (std::isnan(held[i]) ? raised : std::min(held[i], raised)))
+              ok = false;
         }
       }
       if (ok) {
