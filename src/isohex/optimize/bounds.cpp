@@ -49,10 +49,6 @@ Vec3 nearest_in_hull(const std::vector<Vec3>& n) {
   return Vec3::Zero();
 }
 
-// Verdict's value of frame t of hex p (opt::frame()'s numbering: the corners, then the centre).
-double frame_value(const std::array<Vec3, 8>& p, int t) {
-  return opt::scaled_frame(opt::frame(p, t, 1.0), Vec3::Zero(), true).b;
-}
 
 }  // namespace
 
@@ -70,7 +66,7 @@ std::vector<QualityBound> find_quality_bounds(const HexMesh& mesh, const std::ve
     const Hex& hx = mesh.hexes[h];
     const auto p = mesh.corners(h);
     if (std::all_of(hx.begin(), hx.end(), [&](Index v) { return fixed[v] != 0; }))
-      if (const double v = frame_value(p, opt::kCentreFrame); v < level)
+      if (const double v = opt::scaled_frame_value(p, opt::kCentreFrame); v < level)
         out.push_back({QualityBound::Kind::fixed_frame, -1, -1, v, {h}});
     for (int k = 0; k < 8; ++k) {
       if (!fixed[hx[k]]) continue;
@@ -80,7 +76,7 @@ std::vector<QualityBound> find_quality_bounds(const HexMesh& mesh, const std::ve
         if (!fixed[hx[nb[j]]]) free_at = j, ++free_count;
       const Vec3 e[3] = {p[nb[0]] - p[k], p[nb[1]] - p[k], p[nb[2]] - p[k]};
       if (free_count == 0) {
-        if (const double v = frame_value(p, k); v < level)
+        if (const double v = opt::scaled_frame_value(p, k); v < level)
           out.push_back({QualityBound::Kind::fixed_frame, hx[k], -1, v, {h}});
       } else if (free_count == 1) {
         // det[e0 e1 e2] = e_j · (e_{j+1} × e_{j+2}): the free edge's direction against the

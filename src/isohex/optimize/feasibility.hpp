@@ -55,6 +55,10 @@ Vec3 det_gradient(const Mat3& A, const Vec3& c);
 /// (the gradient left zero with `value_only`); −2 for a collapsed column, as Verdict's
 /// degenerate hex, below everything.
 Affine scaled_frame(const Mat3& A, const Vec3& c, bool value_only = false);
+/// Verdict's value of frame t (frame()'s numbering: the 8 corners, then the centre) of hex p.
+inline double scaled_frame_value(const std::array<Vec3, 8>& p, int t) {
+  return scaled_frame(frame(p, t, 1.0), Vec3::Zero(), true).b;
+}
 
 /// The largest Bernstein coefficient of det J of hex p, or 0 when none is positive: the norm of
 /// the worst pass's ratio terms while a vertex (or a patch) moves.

@@ -46,11 +46,13 @@ struct Around {
   bool valid = true;  // no hex valid before is invalid, no edge at the patch shrank too far
 };
 
-// With `sj_out`, each hex's certified scaled Jacobian (−2 where degenerate) too; with
+// With `sj_out` and `ratio_out`, each hex's certified scaled Jacobian (−2 where degenerate)
+// and ratio bound too; with
 // `sj_before`, a hex valid there and not now makes it invalid; with `start`, so does an edge at
 // the patch shorter than `shrink` times its length there.
 Around measure(const HexMesh& mesh, const std::vector<Index>& hexes, const Layout& L, const std::vector<double>* sj_before,
-               const std::vector<Vec3>* start, double shrink, std::vector<double>* sj_out = nullptr) {
+               const std::vector<Vec3>* start, double shrink, std::vector<double>* sj_out = nullptr,
+               std::vector<double>* ratio_out = nullptr) {
   Around r;
   for (std::size_t i = 0; i < hexes.size(); ++i) {
     const Index h = hexes[i];
@@ -62,6 +64,7 @@ Around measure(const HexMesh& mesh, const std::vector<Index>& hexes, const Layou
     r.max_edges = std::max(r.max_edges, edge_ratio(p));
     r.below += q < kQuestionableSJ;
     if (sj_out) sj_out->push_back(q);
+    if (ratio_out) ratio_out->push_back(c.ratio_bound);
     if (sj_before && q <= 0 && (*sj_before)[i] > 0) r.valid = false;
     if (!start) continue;
     for (const auto& e : kHexEdges) {
@@ -129,11 +132,12 @@ void hex_rows(const HexMesh& mesh, Index h, int index, const Layout& L, double n
   }
 }
 
+// `mine`: the hexes the move is for; `caps`: those whose coefficients get cap rows (per hex).
 Rows patch_rows(const HexMesh& mesh, const std::vector<Index>& hexes, const std::vector<double>& norms,
-                const std::vector<std::uint8_t>& caps, const Layout& L, const std::vector<Index>& targets) {
+                const std::vector<std::uint8_t>& mine, const std::vector<std::uint8_t>& caps, const Layout& L) {
   Rows r;
   for (std::size_t i = 0; i < hexes.size(); ++i)
-    hex_rows(mesh, hexes[i], static_cast<int>(i), L, norms[i], std::binary_search(targets.begin(), targets.end(), hexes[i]), caps[i] != 0, r);
+    hex_rows(mesh, hexes[i], static_cast<int>(i), L, norms[i], mine[i] != 0, caps[i] != 0, r);
   return r;
 }
 
@@ -246,13 +250,10 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
   std::sort(hexes.begin(), hexes.end());
   hexes.erase(std::unique(hexes.begin(), hexes.end()), hexes.end());
   std::vector<double> norms, sj0, ratios;
-  for (Index h : hexes) {
-    norms.push_back(bernstein_norm(mesh.corners(h)));
-    ratios.push_back(jacobian_ratio_bound(mesh.corners(h)));
-  }
+  for (Index h : hexes) norms.push_back(bernstein_norm(mesh.corners(h)));
   Layout L;
   L.verts = patch;
-  const Around before = measure(mesh, hexes, L, nullptr, nullptr, 0, &sj0);
+  const Around before = measure(mesh, hexes, L, nullptr, nullptr, 0, &sj0, &ratios);
   // The guards of move_vertex(), over the patch's hexes.
   const double edge_cap = std::max(before.max_edges, before.min_ratio < kPoorJacobianRatio ? options.poor_ratio_edge_limit
                                                                                            : options.max_edge_ratio);
@@ -278,7 +279,7 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
   for (int model = 0; model < options.models; ++model) {
     layout_at(mesh, inc, surface, L);
     if (L.n == 0) break;
-    const Rows rows = patch_rows(mesh, hexes, norms, caps, L, targets);
+    const Rows rows = patch_rows(mesh, hexes, norms, mine, caps, L);
     const double now = lowest(rows, rows, rise);
     if (!(now < options.target)) break;
     const std::vector<double> held = hold_levels(rows, ratios, now, sj_floor, rise, ratio_floor, guarded);
@@ -311,7 +312,7 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
         if (ok) {
           // The hex's terms rise, and no other term falls below its level or below them (the caps
           // are the ratio bound's, checked above on the true values).
-          const Rows y = patch_rows(mesh, hexes, norms, caps, L, targets);
+          const Rows y = patch_rows(mesh, hexes, norms, mine, caps, L);
           ok = y.b.size() == rows.b.size();
           const double raised = ok ? lowest(rows, y, rise) : now;
           ok = ok && raised > now + 1e-9;

@@ -31,7 +31,7 @@ std::vector<Index> worst_frame_vertices(const std::array<Vec3, 8>& p, const Hex&
   int worst = 0;
   double lo = std::numeric_limits<double>::infinity();
   for (int t = 0; t < opt::kFrames; ++t)
-    if (const double v = opt::scaled_frame(opt::frame(p, t, 1.0), Vec3::Zero(), true).b; v < lo) lo = v, worst = t;
+    if (const double v = opt::scaled_frame_value(p, t); v < lo) lo = v, worst = t;
   if (worst == opt::kCentreFrame) return {hex.begin(), hex.end()};
   const auto& n = kCornerNeighbors[worst];
   return {hex[worst], hex[n[0]], hex[n[1]], hex[n[2]]};
