@@ -41,6 +41,7 @@ struct Args {
   double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
   int patch_rounds = WorstOptions{}.patch_rounds;  ///< --patch-rounds
   int worst_passes = WorstOptions{}.passes;        ///< --worst-passes
+  std::optional<double> shape_guard;               ///< --shape-guard
   int* threads = nullptr;
 };
 
@@ -131,6 +132,7 @@ void run(const Args& a) {
     o.shape_options.max_iter = *a.max_iter;
   }
   o.shape_options.tol = a.tol;
+  if (a.shape_guard) o.shape_options.rank_guard = *a.shape_guard;
   o.worst_options.patch_rounds = a.patch_rounds;
   o.worst_options.passes = a.worst_passes;
   o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
@@ -194,7 +196,8 @@ void register_smooth(CLI::App& app) {
       "Examples:\n"
       "  isohex smooth tangled.vtk -o smooth.vtu --untangle --json smooth.json\n"
       "  isohex smooth pillowed.vtu -o out.vtu --untangle --boundary slide --surface-band 0.3 --patch-rounds 10\n"
-      "  isohex smooth block.mesh -o out.vtu --untangle --worst-passes 100 --json r.json   # r.json: worst.proven");
+      "  isohex smooth block.mesh -o out.vtu --untangle --worst-passes 100 --json r.json   # r.json: worst.proven\n"
+      "  isohex smooth good.vtu -o better.vtu --shape-guard 0.3   # no hex falls below 0.3, none below it falls");
   cmd->add_option("mesh", a->in, "Input hex mesh (.vtk .vtu .mesh .inp)")->required();
   cmd->add_option("-o,--output", a->out, "Output mesh")->required();
   cmd->add_flag("--untangle", a->untangle, "First make every hex valid (scaled Jacobian >= --margin where possible)");
@@ -237,6 +240,10 @@ void register_smooth(CLI::App& app) {
                   "Passes of single-vertex max-min moves of the worst-element pass; it stops earlier when a pass "
                   "moves nothing (default 30)")
       ->check(CLI::Range(1, 10000));
+  cmd->add_option("--shape-guard", a->shape_guard,
+                  "The shape stage may not take a hex's scaled Jacobian below the lower of its value and this, nor "
+                  "its jacobian ratio below half of it (default off; the band rounds after the first use 0.2)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--json", a->json, "Write a JSON report (before/after quality, stage results)");
   cmd->add_flag("--skip-non-hex", a->skip_non_hex, "Drop non-hexahedral cells instead of failing");
   a->threads = add_threads_option(cmd);

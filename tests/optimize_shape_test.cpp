@@ -1,4 +1,5 @@
 // Shape optimisation: derivatives, colouring, the guarantees of each stage, determinism.
+#include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/generate.hpp"
 #include "isohex/mesh/topology.hpp"
 #include "isohex/optimize/local_energy.hpp"
@@ -11,6 +12,7 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <numeric>
 #include <set>
 
@@ -174,6 +176,70 @@ TEST(OptimizeShape, WorstPassNeverLowersTheMinimum) {
     for (std::size_t i = 0; i < m.points.size(); ++i)
       if (m.fixed[i]) EXPECT_EQ(m.points[i], before.points[i]);
   }
+}
+
+// The rank of every hex: the lower of its certified scaled Jacobian and twice its ratio bound.
+std::vector<double> ranks(const HexMesh& m) {
+  std::vector<double> r;
+  for (Index h = 0; h < m.num_hexes(); ++h) r.push_back(opt::hex_rank(certified_quality(m.corners(h))));
+  return r;
+}
+
+// With a rank guard the mean objective may not buy its gain with a hex's minimum: no hex
+// ends below the lower of its rank before and the guard. Without it the same runs take
+// hexes below (so the guard is what holds them), after the worst pass has raised them.
+TEST(OptimizeShape, RankGuardHoldsEveryHex) {
+  constexpr double kGuard = 0.75;
+  std::size_t fell_unguarded = 0;
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    HexMesh m = jittered_box(5, 0.3, seed);
+    optimize_shape(m, m.fixed);
+    improve_worst(m, m.fixed, WorstOptions{.below = 1.5, .count = 200, .passes = 10, .target = 0.9});
+    const std::vector<double> before = ranks(m);
+    ASSERT_GT(*std::min_element(before.begin(), before.end()), 0) << seed;
+    HexMesh free = m;
+    optimize_shape(free, free.fixed);
+    const std::vector<double> unguarded = ranks(free);
+    ShapeOptions so;
+    so.rank_guard = kGuard;
+    const ShapeResult r = optimize_shape(m, m.fixed, so);
+    EXPECT_GT(r.iterations, 0);
+    EXPECT_LE(r.objective_after, r.objective_before);
+    const std::vector<double> after = ranks(m);
+    for (std::size_t h = 0; h < after.size(); ++h) {
+      EXPECT_GE(after[h], std::min(before[h], kGuard)) << seed << " hex " << h;
+      fell_unguarded += unguarded[h] < std::min(before[h], kGuard);
+    }
+  }
+  EXPECT_GT(fell_unguarded, 0u);
+}
+
+// `isohex smooth --shape-guard` holds the same guard (the worst pass off, so that the shape
+// stage alone moves vertices), and a value out of range exits 2 naming the option.
+TEST(OptimizeShape, CliShapeGuard) {
+  using test::quote;
+  const auto dir = test::scratch_dir();
+  HexMesh m = jittered_box(5, 0.3, 2);
+  optimize_shape(m, m.fixed);
+  improve_worst(m, m.fixed, WorstOptions{.below = 1.5, .count = 200, .passes = 10, .target = 0.9});
+  io::write_mesh(dir / "in.vtu", m);
+  const std::vector<double> before = ranks(io::read_mesh(dir / "in.vtu"));
+  const auto fell = [&](const std::string& extra) {
+    std::string out;
+    EXPECT_EQ(test::run_cli("smooth " + quote(dir / "in.vtu") + " -o " + quote(dir / "out.vtu") + " --no-worst" + extra, &out), 0)
+        << out;
+    const std::vector<double> after = ranks(io::read_mesh(dir / "out.vtu"));
+    std::size_t n = 0;
+    for (std::size_t h = 0; h < after.size(); ++h) n += after[h] < std::min(before[h], 0.75);
+    return n;
+  };
+  EXPECT_GT(fell(""), 0u);
+  EXPECT_EQ(fell(" --shape-guard 0.75"), 0u);
+  std::string out;
+  EXPECT_EQ(test::run_cli("smooth " + quote(dir / "in.vtu") + " -o " + quote(dir / "bad.vtu") + " --shape-guard 1.5", &out), 2)
+      << out;
+  EXPECT_NE(out.find("--shape-guard"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.vtu"));
 }
 
 TEST(OptimizeShape, SameBitsForOneAndTwoThreads) {

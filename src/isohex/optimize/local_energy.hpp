@@ -12,11 +12,14 @@
 #include "isohex/mesh/topology.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <vector>
 
 namespace isohex::opt {
@@ -63,6 +66,9 @@ struct EnergyParams {
   bool bernstein_of(Index h) const { return untangle && bernstein && (*bernstein)[static_cast<std::size_t>(h)]; }
   /// The number of frames hex h contributes.
   int frames_of(Index h) const { return interior && (*interior)[static_cast<std::size_t>(h)] ? kAllFrames : kFrames; }
+  /// shape: no step takes a hex's rank (hex_rank()) below the lower of its rank before the step
+  /// and this (-inf: no such guard; ShapeOptions::rank_guard).
+  double rank_guard = -std::numeric_limits<double>::infinity();
   /// ε of hex h under these parameters.
   double eps_of(Index h) const { return hex_eps ? std::max(eps, (*hex_eps)[static_cast<std::size_t>(h)]) : eps; }
 };
@@ -102,10 +108,21 @@ bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len);
 /// with v at x, as hex_feasible() asks: for a shape step whose energy is finite (so the frames v
 /// changes are feasible) from a place where every hex around v is hex_feasible().
 /// With `ratio_floor` (one value per hex around v, in incidence order), also that no hex's
-/// jacobian_ratio_bound() falls below its floor.
+/// jacobian_ratio_bound() falls below its floor; with `rank_floor` (the same), that no hex's
+/// hex_rank() does.
 bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                     const Vec3& x, const std::vector<std::uint8_t>* skip,
-                    const std::vector<double>* ratio_floor = nullptr);
+                    const std::vector<double>* ratio_floor = nullptr, const std::vector<double>* rank_floor = nullptr);
+
+/// The ratio terms are weighted this against the scaled Jacobian's frame values: 2 puts a ratio
+/// of 0.1 (poor, kPoorJacobianRatio) level with a scaled Jacobian of 0.2.
+inline constexpr double kRatioWeight = 2;
+
+/// The worst pass's rank of a hex: the lower of its certified scaled Jacobian (-2 for a
+/// degenerate hex) and kRatioWeight times its jacobian ratio bound.
+inline double hex_rank(const CertifiedQuality& c) {
+  return std::min(is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian, kRatioWeight * c.ratio_bound);
+}
 
 /// No shape step takes a hex's jacobian_ratio_bound() from this or above to below it (a ratio
 /// of 0.1 is poor, kPoorJacobianRatio; the bound is at most the ratio).

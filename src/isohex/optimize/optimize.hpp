@@ -56,6 +56,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -206,6 +207,11 @@ struct ShapeOptions {
   double tol = 1e-5;         ///< stop when a sweep lowers the objective by less than tol (relative)
   double grad_tol = 1e-8;    ///< ... or when the largest vertex gradient (× edge length) is below this
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
+  /// No step takes a hex's rank, the lower of its certified scaled Jacobian and twice its
+  /// jacobian ratio bound, below the lower of its rank before the step and this (-inf: off).
+  /// The mean objective otherwise trades minima for the mean: `isohex mesh`'s band rounds set
+  /// 0.2 (kQuestionableSJ) so that they never undo what the worst pass before them reached.
+  double rank_guard = -std::numeric_limits<double>::infinity();
   ProgressCallback progress;
 };
 

@@ -12,15 +12,12 @@
 
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 
 #include <vector>
 
 namespace isohex::opt {
-
-/// The ratio terms are weighted this against the scaled Jacobian's frame values: 2 puts a ratio
-/// of 0.1 (poor, kPoorJacobianRatio) level with a scaled Jacobian of 0.2.
-inline constexpr double kRatioWeight = 2;
 
 /// Moves the free vertices `patch` (ascending, none fixed) together for the hexes `targets`
 /// (ascending): the smallest of their weighted Bernstein ratio terms and scaled-Jacobian frames

@@ -46,6 +46,7 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   for (int it = 1; it <= options.max_iter; ++it) {
     opt::EnergyParams params;
     params.surface = options.surface;
+    params.rank_guard = options.rank_guard;
     const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 1);
     const double e_new = mean_objective(mesh, inv_len, bad);
     res.iterations = it;

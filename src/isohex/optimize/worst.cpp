@@ -306,7 +306,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     }
     const CertifiedQuality c = certified_quality(p);
     sj[h] = is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian;
-    rank[h] = std::min(sj[h], kRatioWeight * c.ratio_bound);
+    rank[h] = opt::hex_rank(c);
   };
   for (Index h = 0; h < mesh.num_hexes(); ++h) update(h);
   const auto mesh_min = [&] { return sj.empty() ? 1.0 : *std::min_element(sj.begin(), sj.end()); };
