@@ -353,7 +353,9 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   std::vector<double> ratio_floor, rank_floor;
   if (!params.untangle)
     for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
-      const CertifiedQuality c = certified_quality(mesh.corners(inc.ids[i]));
+      const auto p = mesh.corners(inc.ids[i]);
+      // The scaled Jacobian and its certificate only where the guard needs them.
+      const CertifiedQuality c = guarded ? certified_quality(p) : CertifiedQuality{0, jacobian_ratio_bound(p)};
       ratio_floor.push_back(c.ratio_bound >= kShapeRatioFloor ? kShapeRatioFloor : -kInf);
       if (guarded) rank_floor.push_back(std::min(hex_rank(c), params.rank_guard));
     }
