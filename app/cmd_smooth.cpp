@@ -197,7 +197,7 @@ void register_smooth(CLI::App& app) {
       "  isohex smooth tangled.vtk -o smooth.vtu --untangle --json smooth.json\n"
       "  isohex smooth pillowed.vtu -o out.vtu --untangle --boundary slide --surface-band 0.3 --patch-rounds 10\n"
       "  isohex smooth block.mesh -o out.vtu --untangle --worst-passes 100 --json r.json   # r.json: worst.proven\n"
-      "  isohex smooth good.vtu -o better.vtu --shape-guard 0.3   # no hex falls below 0.3, none below it falls");
+      "  isohex smooth good.vtu -o better.vtu --shape-guard 0.3   # none falls below 0.3 by rank, none below it falls");
   cmd->add_option("mesh", a->in, "Input hex mesh (.vtk .vtu .mesh .inp)")->required();
   cmd->add_option("-o,--output", a->out, "Output mesh")->required();
   cmd->add_flag("--untangle", a->untangle, "First make every hex valid (scaled Jacobian >= --margin where possible)");
@@ -241,8 +241,9 @@ void register_smooth(CLI::App& app) {
                   "moves nothing (default 30)")
       ->check(CLI::Range(1, 10000));
   cmd->add_option("--shape-guard", a->shape_guard,
-                  "The shape stage may not take a hex's scaled Jacobian below the lower of its value and this, nor "
-                  "its jacobian ratio below half of it (default off; the band rounds after the first use 0.2)")
+                  "No shape step may take a hex's rank (the lower of its scaled Jacobian and twice its jacobian ratio) "
+                  "below the lower of that rank before the step and this (default off; the band rounds after the "
+                  "first use 0.2)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--json", a->json, "Write a JSON report (before/after quality, stage results)");
   cmd->add_flag("--skip-non-hex", a->skip_non_hex, "Drop non-hexahedral cells instead of failing");
