@@ -50,16 +50,9 @@ HexMesh bone_cluster(std::vector<Index>& targets, bool boundary_free = false) {
   return m;
 }
 
-// The worst pass's rank of a hex: the lower of its certified scaled Jacobian and twice its
-// jacobian ratio bound.
-double rank_of(const HexMesh& m, Index h) {
-  const CertifiedQuality c = certified_quality(m.corners(h));
-  return std::min(c.scaled_jacobian, 2 * c.ratio_bound);
-}
-
 double lowest_rank(const HexMesh& m, const std::vector<Index>& hexes) {
   double lo = 2;
-  for (Index h : hexes) lo = std::min(lo, rank_of(m, h));
+  for (Index h : hexes) lo = std::min(lo, opt::hex_rank(certified_quality(m.corners(h))));
   return lo;
 }
 
