@@ -41,6 +41,7 @@ struct Args {
   double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
   int patch_rounds = WorstOptions{}.patch_rounds;  ///< --patch-rounds
   int worst_passes = WorstOptions{}.passes;        ///< --worst-passes
+  long long search_trials = static_cast<long long>(WorstOptions{}.search_trials);  ///< --search-trials
   std::optional<double> shape_guard;               ///< --shape-guard
   int* threads = nullptr;
 };
@@ -135,6 +136,7 @@ void run(const Args& a) {
   if (a.shape_guard) o.shape_options.rank_guard = *a.shape_guard;
   o.worst_options.patch_rounds = a.patch_rounds;
   o.worst_options.passes = a.worst_passes;
+  o.worst_options.search_trials = static_cast<std::size_t>(a.search_trials);
   o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = progress;
   o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = surface.get();
   report.update(run_optimisation(mesh, fixed, o));
@@ -197,7 +199,8 @@ void register_smooth(CLI::App& app) {
       "  isohex smooth tangled.vtk -o smooth.vtu --untangle --json smooth.json\n"
       "  isohex smooth pillowed.vtu -o out.vtu --untangle --boundary slide --surface-band 0.3 --patch-rounds 10\n"
       "  isohex smooth block.mesh -o out.vtu --untangle --worst-passes 100 --json r.json   # r.json: worst.proven\n"
-      "  isohex smooth good.vtu -o better.vtu --shape-guard 0.3   # none falls below 0.3 by rank, none below it falls");
+      "  isohex smooth good.vtu -o better.vtu --shape-guard 0.3   # none falls below 0.3 by rank, none below it falls\n"
+      "  isohex smooth stuck.vtu -o out.vtu --search-trials 1000000   # a longer random walk where hexes stay below 0.2");
   cmd->add_option("mesh", a->in, "Input hex mesh (.vtk .vtu .mesh .inp)")->required();
   cmd->add_option("-o,--output", a->out, "Output mesh")->required();
   cmd->add_flag("--untangle", a->untangle, "First make every hex valid (scaled Jacobian >= --margin where possible)");
@@ -240,6 +243,12 @@ void register_smooth(CLI::App& app) {
                   "Passes of single-vertex max-min moves of the worst-element pass; it stops earlier when a pass "
                   "moves nothing (default 30)")
       ->check(CLI::Range(1, 10000));
+  cmd->add_option("--search-trials", a->search_trials,
+                  "Last of the worst-element pass, where at most 100 hexes are still below 0.2 (scaled Jacobian, or "
+                  "twice the jacobian ratio): a random walk of the free vertices within two rings of each cluster of "
+                  "them, each step taken when no hex around it falls below the cluster's minimum; at most this many "
+                  "steps a cluster (default 200000; 0: off). Deterministic")
+      ->check(CLI::Range(0LL, 100000000LL));
   cmd->add_option("--shape-guard", a->shape_guard,
                   "No shape step may take a hex's rank (the lower of its scaled Jacobian and twice its jacobian ratio) "
                   "below the lower of that rank before the step and this (default off; the band rounds after the "

@@ -129,12 +129,15 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
                 {"objective_after", s.objective_after}, {"frozen_hexes", s.frozen_hexes}, {"seconds", r.shape_seconds}};
   if (r.worst_run) {
     const WorstResult& w = r.worst;
-    fmt::print("worst: {} passes, {} moves{}, min SJ {:.4f} -> {:.4f}\n", w.passes, w.moves,
-               w.patch_moves ? fmt::format(" and {} joint moves of patches", w.patch_moves) : "", w.min_sj_before,
-               w.min_sj_after);
+    fmt::print("worst: {} passes, {} moves{}{}, min SJ {:.4f} -> {:.4f}\n", w.passes, w.moves,
+               w.patch_moves ? fmt::format(" and {} joint moves of patches", w.patch_moves) : "",
+               w.searched ? fmt::format("; random search raised {} of {} clusters", w.search_gains, w.searched) : "",
+               w.min_sj_before, w.min_sj_after);
     j["worst"] = {{"passes", w.passes},
                   {"moves", w.moves},
                   {"patch_moves", w.patch_moves},
+                  {"searched", w.searched},
+                  {"search_gains", w.search_gains},
                   {"min_sj_before", w.min_sj_before},
                   {"min_sj_after", w.min_sj_after},
                   {"seconds", r.worst_seconds}};

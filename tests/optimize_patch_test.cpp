@@ -26,28 +26,7 @@ namespace {
 // tests/data/bone_cluster.txt: a piece of a real mesh, the patch's interior vertices free (and
 // its boundary vertices too with `boundary_free`), and the hexes it is for.
 HexMesh bone_cluster(std::vector<Index>& targets, bool boundary_free = false) {
-  std::ifstream in(std::string(ISOHEX_TEST_DATA) + "/bone_cluster.txt");
-  HexMesh m;
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::string tag;
-    s >> tag;
-    if (tag == "v") {
-      Vec3 p;
-      int role = 0;
-      s >> p.x() >> p.y() >> p.z() >> role;
-      m.points.push_back(p);
-      m.fixed.push_back(role == 1 || (role == 2 && boundary_free) ? 0 : 1);
-    } else if (tag == "h") {
-      Hex h;
-      for (Index& v : h) s >> v;
-      m.hexes.push_back(h);
-    } else if (tag == "t") {
-      for (Index t; s >> t;) targets.push_back(t);
-    }
-  }
-  return m;
+  return test::read_piece("bone_cluster.txt", targets, boundary_free);
 }
 
 double lowest_rank(const HexMesh& m, const std::vector<Index>& hexes) {
@@ -100,6 +79,7 @@ TEST(OptimizePatch, JointMovesGoOnWhereSingleMovesStop) {
   ASSERT_EQ(targets.size(), 4u);
   WorstOptions single;
   single.patch_rounds = 0;
+  single.search_trials = 0;
   single.passes = 500;
   HexMesh stalled = before;
   const WorstResult s = improve_worst(stalled, stalled.fixed, single);
@@ -108,7 +88,9 @@ TEST(OptimizePatch, JointMovesGoOnWhereSingleMovesStop) {
   ASSERT_LT(stalled_rank, 0.25);
 
   HexMesh joint = stalled;
-  const WorstResult r = improve_worst(joint, joint.fixed);
+  WorstOptions joint_only;
+  joint_only.search_trials = 0;
+  const WorstResult r = improve_worst(joint, joint.fixed, joint_only);
   EXPECT_GT(r.patch_moves, 0u);
   const double joint_rank = lowest_rank(joint, targets);
   EXPECT_GT(joint_rank, stalled_rank + 0.005);
@@ -175,25 +157,7 @@ TEST(OptimizePatch, MovesKeepTheirGuards) {
 // joint moves are counted in the JSON report, 0 turns them
 // off, and a value out of range exits 2 before anything is written.
 TEST(OptimizePatch, CliSmoothCountsJointMovesAndRefusesABadValue) {
-  using test::quote;
-  const auto dir = test::scratch_dir();
-  std::vector<Index> targets;
-  io::write_mesh(dir / "in.vtu", bone_cluster(targets, true));
-  const auto patch_moves = [&](const std::string& extra) {
-    std::string out;
-    const int rc = test::run_cli("smooth " + quote(dir / "in.vtu") + " -o " + quote(dir / "out.vtu") +
-                                     " --fixed file --max-iter 0 --json " + quote(dir / "r.json") + extra,
-                                 &out);
-    EXPECT_EQ(rc, 0) << out;
-    std::ifstream in(dir / "r.json");
-    return nlohmann::json::parse(in)["worst"]["patch_moves"].get<std::size_t>();
-  };
-  EXPECT_GT(patch_moves(""), 0u);
-  EXPECT_EQ(patch_moves(" --patch-rounds 0"), 0u);
-  std::string out;
-  EXPECT_EQ(test::run_cli("smooth " + quote(dir / "in.vtu") + " -o " + quote(dir / "bad.vtu") + " --patch-rounds -1", &out),
-            2)
-      << out;
-  EXPECT_NE(out.find("--patch-rounds"), std::string::npos) << out;
-  EXPECT_FALSE(std::filesystem::exists(dir / "bad.vtu"));
+  EXPECT_GT(test::smooth_piece_count("bone_cluster.txt", "", "patch_moves"), 0u);
+  EXPECT_EQ(test::smooth_piece_count("bone_cluster.txt", " --patch-rounds 0", "patch_moves"), 0u);
+  test::expect_smooth_refuses("bone_cluster.txt", "--patch-rounds", "-1");
 }

@@ -1,12 +1,16 @@
 #include "test_support.hpp"
 
+#include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/generate.hpp"
 #include "isohex/volume/volume_io.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <sys/wait.h>
 
 namespace isohex::test {
@@ -63,6 +67,58 @@ fs::path scratch_dir() {
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
+}
+
+HexMesh read_piece(const std::string& name, std::vector<Index>& targets, bool boundary_free) {
+  std::ifstream in(std::string(ISOHEX_TEST_DATA) + "/" + name);
+  EXPECT_TRUE(in) << name;
+  HexMesh m;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string tag;
+    s >> tag;
+    if (tag == "v") {
+      Vec3 p;
+      int role = 0;
+      s >> p.x() >> p.y() >> p.z() >> role;
+      m.points.push_back(p);
+      m.fixed.push_back(role == 1 || (role == 2 && boundary_free) ? 0 : 1);
+    } else if (tag == "h") {
+      Hex h;
+      for (Index& v : h) s >> v;
+      m.hexes.push_back(h);
+    } else if (tag == "t") {
+      for (Index t; s >> t;) targets.push_back(t);
+    }
+  }
+  return m;
+}
+
+std::size_t smooth_piece_count(const std::string& name, const std::string& extra, const std::string& key) {
+  const auto dir = scratch_dir() / "piece";
+  std::filesystem::create_directories(dir);
+  std::vector<Index> targets;
+  io::write_mesh(dir / "in.vtu", read_piece(name, targets, true));
+  std::string out;
+  const int rc = run_cli("smooth " + quote(dir / "in.vtu") + " -o " + quote(dir / "out.vtu") +
+                             " --fixed file --max-iter 0 --json " + quote(dir / "r.json") + extra,
+                         &out);
+  EXPECT_EQ(rc, 0) << out;
+  std::ifstream in(dir / "r.json");
+  return nlohmann::json::parse(in)["worst"][key].get<std::size_t>();
+}
+
+void expect_smooth_refuses(const std::string& name, const std::string& option, const std::string& value) {
+  const auto dir = scratch_dir() / "refused";
+  std::filesystem::create_directories(dir);
+  std::vector<Index> targets;
+  io::write_mesh(dir / "in.vtu", read_piece(name, targets, true));
+  std::string out;
+  EXPECT_EQ(run_cli("smooth " + quote(dir / "in.vtu") + " -o " + quote(dir / "bad.vtu") + " " + option + " " + value, &out), 2)
+      << out;
+  EXPECT_NE(out.find(option), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.vtu"));
 }
 
 HexMesh grid_mesh(int nx, int ny, int nz, double h) {

@@ -28,6 +28,20 @@ HexMesh grid_mesh(int nx, int ny, int nz, double h = 1.0);
 /// the listed samples set to the listed values (n >= 8).
 Volume block_volume(Index n, const std::vector<std::pair<std::array<Index, 3>, float>>& set);
 
+/// A piece of a real mesh from tests/data/<name> ('v x y z role' per vertex, role 0 held, 1 a
+/// free interior vertex, 2 a boundary vertex; 'h' + 8 vertex ids per hex; 't' the hexes the
+/// piece is for, into `targets`). Vertices of role 1 are free (HexMesh::fixed 0), those of
+/// role 2 too with `boundary_free`.
+HexMesh read_piece(const std::string& name, std::vector<Index>& targets, bool boundary_free = false);
+
+/// `isohex smooth` on the piece `name` (read_piece(), boundary vertices free, the others held
+/// through `--fixed file`), shape stage off, with `extra` options: the count `worst.<key>` of
+/// its JSON report (the run must exit 0).
+std::size_t smooth_piece_count(const std::string& name, const std::string& extra, const std::string& key);
+/// `isohex smooth` on the piece with `option value` out of range: exit 2, the option named, no
+/// output written.
+void expect_smooth_refuses(const std::string& name, const std::string& option, const std::string& value);
+
 /// The corners of the unit cube in VTK order.
 std::array<Vec3, 8> unit_cube();
 /// `path` in single quotes, for run_cli command lines.

@@ -281,6 +281,16 @@ struct WorstOptions {
   /// the single moves but a region no joint move repairs (headsq with its boundary fixed kept
   /// 746 through five rounds that cost 6 times the rest of the stage).
   std::size_t patch_max_poor = 100;
+  /// Last, while at most patch_max_poor hexes are below 0.2 by rank: a random walk over the free
+  /// vertices within `search_rings` vertex rings of each cluster still below (at most
+  /// `search_vertices` of them), up to `search_trials` steps a cluster, each step taken when no
+  /// hex around it falls below the region's minimum, under the single moves' guards. The
+  /// max–min ascents stop at stationary points of the nonsmooth minimum that are not its maximum
+  /// (cthead's bone at iso 1200, h 5: four pillow hexes at a ratio of 0.052 through every
+  /// single and joint move); the walk crosses the level set of the minimum sideways. 0: off.
+  std::size_t search_trials = 200000;
+  int search_rings = 2;
+  std::size_t search_vertices = 400;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   ProgressCallback progress;
 };
@@ -290,6 +300,7 @@ struct WorstResult {
   int passes = 0;
   std::size_t moves = 0;
   std::size_t patch_moves = 0;  ///< joint moves of patches (WorstOptions::patch_rounds)
+  std::size_t searched = 0, search_gains = 0;  ///< clusters the random search ran on, and raised
   double min_sj_before = 0, min_sj_after = 0;
   /// With fixed vertices and hexes still below 0.2 at the end: find_quality_bounds() at 0.2, the
   /// sets of hexes that no placement of the free vertices lifts all to 0.2. A hex below 0.2 in

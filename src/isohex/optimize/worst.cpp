@@ -4,6 +4,7 @@
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/patch.hpp"
+#include "isohex/optimize/search.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/jacobian_bounds.hpp"
@@ -398,6 +399,27 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     if (options.progress) options.progress({"patch", round + 1, static_cast<double>(moved), res.min_sj_after, 0});
     if (moved == 0) break;
     single_passes(std::min(options.passes, 10));
+  }
+  // Last resort: the random walk round each cluster still below 0.2 by rank.
+  sort_worst_first();
+  if (options.search_trials > 0 &&
+      !(options.patch_max_poor < order.size() && rank[order[options.patch_max_poor]] < kQuestionableSJ)) {
+    std::fill(clustered.begin(), clustered.end(), 0);
+    std::size_t gains = 0;
+    for (std::size_t i = 0; i < order.size() && rank[order[i]] < kQuestionableSJ; ++i) {
+      const Index h = order[i];
+      if (clustered[h]) continue;
+      const std::vector<Index> cluster = cluster_of(h);
+      const opt::SearchOutcome o = opt::search_region(mesh, inc, fixed, cluster, start, options, mesh_min());
+      ++res.searched;
+      if (!(o.after > o.before)) continue;
+      ++gains;
+      for (Index g = 0; g < mesh.num_hexes(); ++g) update(g);  // the walk moved up to search_vertices vertices
+    }
+    res.search_gains += gains;
+    res.min_sj_after = mesh_min();
+    if (options.progress) options.progress({"search", 1, static_cast<double>(gains), res.min_sj_after, 0});
+    if (gains > 0) single_passes(std::min(options.passes, 10));
   }
   if (!fixed.empty() && res.min_sj_after < kQuestionableSJ) res.proven = find_quality_bounds(mesh, fixed, kQuestionableSJ);
   return res;
