@@ -34,8 +34,9 @@ struct SearchOutcome {
 /// band), and the step is taken when no hex around the vertex falls below the smallest rank of
 /// the region now, and each keeps the worst pass's guards against its own value when the
 /// search began: certified scaled Jacobian not below the lower of that and the higher of
-/// options.sj_floor and `mesh_min`, ratio bound not below the lower of that and 0.1, edge ratio
-/// within WorstOptions' limits, no edge at the vertex shorter than min_edge_shrink of its
+/// options.sj_floor and `mesh_min`, ratio bound not below the lower of that and
+/// options.ratio_floor, edge ratio not above the higher of that and options.max_edge_ratio (no
+/// exception for poor ratios), no edge at the vertex shorter than min_edge_shrink of its
 /// length in `start`. Half of the steps go to vertices of the region's worst hexes. It stops
 /// at options.search_trials steps, when every hex of the region reaches a rank of 0.2, or when
 /// the minimum has not risen for a quarter of the budget; without a gain the vertices go back
