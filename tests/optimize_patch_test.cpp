@@ -77,13 +77,9 @@ TEST(OptimizePatch, JointMovesGoOnWhereSingleMovesStop) {
   const HexMesh before = bone_cluster(targets, true);
   ASSERT_EQ(before.num_hexes(), 31);
   ASSERT_EQ(targets.size(), 4u);
-  WorstOptions single;
-  single.patch_rounds = 0;
-  single.search_trials = 0;
-  single.passes = 500;
   HexMesh stalled = before;
-  const WorstResult s = improve_worst(stalled, stalled.fixed, single);
-  ASSERT_LT(s.passes, single.passes);  // it stopped: no single move gains
+  const WorstResult s = test::stall_single_moves(stalled, 500);
+  ASSERT_LT(s.passes, 500);  // it stopped: no single move gains
   const double stalled_rank = lowest_rank(stalled, targets);
   ASSERT_LT(stalled_rank, 0.25);
 

@@ -65,19 +65,16 @@ TEST(OptimizeSearch, WalksOnWhereTheMaxMinMovesStall) {
   const double start = lowest_rank(piece);
   ASSERT_LT(start, 0.11);
 
-  WorstOptions ascent;
-  ascent.search_trials = 0;
-  ascent.patch_rounds = 0;
-  ascent.passes = 1000;
   HexMesh stalled = piece;
-  const WorstResult s = improve_worst(stalled, stalled.fixed, ascent);
-  ASSERT_LT(s.passes, ascent.passes);  // it stopped: no single move gains
+  const WorstResult s = test::stall_single_moves(stalled, 1000);
+  ASSERT_LT(s.passes, 1000);  // it stopped: no single move gains
   EXPECT_EQ(s.searched, 0u);
   const double stalled_rank = lowest_rank(stalled);
   EXPECT_LT(stalled_rank, 0.19);
 
-  WorstOptions walk = ascent;
-  walk.search_trials = WorstOptions{}.search_trials;
+  WorstOptions walk;  // the single moves and the walk, as above without the joint moves
+  walk.patch_rounds = 0;
+  walk.passes = 1000;
   HexMesh walked = stalled;
   const WorstResult w = improve_worst(walked, walked.fixed, walk);
   EXPECT_GE(w.searched, 1u);

@@ -95,6 +95,14 @@ HexMesh read_piece(const std::string& name, std::vector<Index>& targets, bool bo
   return m;
 }
 
+WorstResult stall_single_moves(HexMesh& m, int passes) {
+  WorstOptions single;
+  single.patch_rounds = 0;
+  single.search_trials = 0;
+  single.passes = passes;
+  return improve_worst(m, m.fixed, single);
+}
+
 std::size_t smooth_piece_count(const std::string& name, const std::string& extra, const std::string& key) {
   const auto dir = scratch_dir() / "piece";
   std::filesystem::create_directories(dir);

@@ -2,6 +2,7 @@
 // Helpers shared by the tests: data paths, a scratch folder, generated meshes, running the CLI.
 
 #include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/optimize/optimize.hpp"
 #include "isohex/volume/volume.hpp"
 
 #include <array>
@@ -34,10 +35,18 @@ Volume block_volume(Index n, const std::vector<std::pair<std::array<Index, 3>, f
 /// role 2 too with `boundary_free`.
 HexMesh read_piece(const std::string& name, std::vector<Index>& targets, bool boundary_free = false);
 
+/// improve_worst() with the single moves only (no joint moves, no walk), up to `passes`
+/// passes on m's free vertices (fewer passes in the result: they stopped, no single move gains).
+WorstResult stall_single_moves(HexMesh& m, int passes);
+
 /// `isohex smooth` on the piece `name` (read_piece(), boundary vertices free, the others held
 /// through `--fixed file`), shape stage off, with `extra` options: the count `worst.<key>` of
 /// its JSON report (the run must exit 0).
 std::size_t smooth_piece_count(const std::string& name, const std::string& extra, const std::string& key);
+/// improve_worst() with the single moves only (no joint moves, no walk), up to `passes`
+/// passes on m's free vertices (fewer passes in the result: they stopped, no single move gains).
+WorstResult stall_single_moves(HexMesh& m, int passes);
+
 /// `isohex smooth` on the piece with `option value` out of range: exit 2, the option named, no
 /// output written.
 void expect_smooth_refuses(const std::string& name, const std::string& option, const std::string& value);

@@ -105,9 +105,8 @@ SearchOutcome search_region(HexMesh& mesh, const Incidence& inc, const std::vect
     const CertifiedQuality c = certified_quality(p);
     const double sj = is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian;
     const double e = edge_ratio(p);
-    // The floors of the single moves, but the edge-ratio cap without their exception for poor
-    // ratios: the walk is free to stretch every hex it reaches (ECR armadillo's largest edge
-    // ratio went from 19.7 to 34.5 with that exception).
+    // The floors of the single moves, but the edge-ratio cap without their exception of 100 for
+    // poor ratios: the walk moves every vertex of its region, not only those of a poor hex.
     state.push_back({hex_rank(c), std::min(sj, sj_level), std::min(c.ratio_bound, options.ratio_floor),
                      std::max(e, options.max_edge_ratio)});
   }
@@ -192,6 +191,8 @@ SearchOutcome search_region(HexMesh& mesh, const Incidence& inc, const std::vect
   if (!(now > out.before)) {  // a walk without a gain leaves nothing behind
     for (std::size_t s = 0; s < verts.size(); ++s) mesh.points[verts[s]] = saved[s];
     out.after = out.before;
+  } else {
+    out.vertices = std::move(verts);
   }
   return out;
 }

@@ -24,6 +24,7 @@ namespace isohex::opt {
 /// What search_region() did.
 struct SearchOutcome {
   std::size_t trials = 0, accepted = 0;
+  std::vector<Index> vertices;   ///< the vertices the walk may have moved (ascending)
   double before = 0, after = 0;  ///< the region's smallest rank (hex_rank()) before and after
 };
 

@@ -367,11 +367,14 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     std::sort(c.begin(), c.end());
     return c;
   };
+  // More hexes below 0.2 than patch_max_poor (with `order` sorted) are not stalls of the single
+  // moves but a region the end game cannot repair (a boundary held fixed at knife edges).
+  const auto too_many_poor = [&] {
+    return options.patch_max_poor < order.size() && rank[order[options.patch_max_poor]] < kQuestionableSJ;
+  };
   for (int round = 0; round < options.patch_rounds; ++round) {
     sort_worst_first();
-    // The end game only: with more hexes below 0.2 than patch_max_poor, they are not single
-    // stalls but a region the joint moves cannot repair (a boundary held fixed at knife edges).
-    if (options.patch_max_poor < order.size() && rank[order[options.patch_max_poor]] < kQuestionableSJ) break;
+    if (too_many_poor()) break;
     std::fill(clustered.begin(), clustered.end(), 0);
     std::size_t moved = 0;
     for (std::size_t i = 0; i < order.size() && i < options.count && rank[order[i]] < kQuestionableSJ; ++i) {
@@ -402,8 +405,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   }
   // Last resort: the random walk round each cluster still below 0.2 by rank.
   sort_worst_first();
-  if (options.search_trials > 0 &&
-      !(options.patch_max_poor < order.size() && rank[order[options.patch_max_poor]] < kQuestionableSJ)) {
+  if (options.search_trials > 0 && !too_many_poor()) {
     std::fill(clustered.begin(), clustered.end(), 0);
     std::size_t gains = 0;
     for (std::size_t i = 0; i < order.size() && rank[order[i]] < kQuestionableSJ; ++i) {
@@ -414,7 +416,8 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       ++res.searched;
       if (!(o.after > o.before)) continue;
       ++gains;
-      for (Index g = 0; g < mesh.num_hexes(); ++g) update(g);  // the walk moved up to search_vertices vertices
+      for (Index v : o.vertices)
+        for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
     }
     res.search_gains += gains;
     res.min_sj_after = mesh_min();
