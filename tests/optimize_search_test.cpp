@@ -137,6 +137,46 @@ TEST(OptimizeSearch, KeepsItsGuards) {
   EXPECT_EQ(runs, 8u);
 }
 
+// Hexes held (improve_worst() holds the members of find_quality_bounds()' sets, which its fixed
+// vertices keep below 0.2): on the stalled piece, the walk's minimum is its lowest hex's rank;
+// with that hex held, the minimum of the others, which the walk lifts to 0.2 while the held hex
+// never falls below its own rank (it is the lowest: the lower of that and the others' minimum).
+TEST(OptimizeSearch, HeldHexesDoNotCountInTheMinimum) {
+  std::vector<Index> targets;
+  HexMesh stalled = test::read_piece("bone_stall.txt", targets, true);
+  test::stall_single_moves(stalled, 1000);
+  const auto rank_of = [](const HexMesh& m, Index h) { return opt::hex_rank(certified_quality(m.corners(h))); };
+  const Index h0 = *std::min_element(targets.begin(), targets.end(),
+                                     [&](Index a, Index b) { return rank_of(stalled, a) < rank_of(stalled, b); });
+  std::vector<std::uint8_t> held(stalled.hexes.size(), 0);
+  held[h0] = 1;
+  const auto others_min = [&](const HexMesh& m) {
+    double lo = 2;
+    for (Index h = 0; h < m.num_hexes(); ++h)
+      if (h != h0) lo = std::min(lo, rank_of(m, h));
+    return lo;
+  };
+  ASSERT_LT(rank_of(stalled, h0), others_min(stalled) - 0.005);
+  double mesh_min = 2;
+  for (Index h = 0; h < stalled.num_hexes(); ++h) mesh_min = std::min(mesh_min, certified_scaled_jacobian(stalled.corners(h)));
+  const Incidence inc = vertex_hexes(stalled);
+  WorstOptions o;
+  o.search_trials = 40000;
+
+  HexMesh counted = stalled;
+  const opt::SearchOutcome c = opt::search_region(counted, inc, counted.fixed, targets, stalled.points, o, mesh_min);
+  EXPECT_EQ(c.before, rank_of(stalled, h0));
+  HexMesh walked = stalled;
+  const opt::SearchOutcome w = opt::search_region(walked, inc, walked.fixed, targets, stalled.points, o, mesh_min, held);
+  EXPECT_EQ(w.before, others_min(stalled));
+  EXPECT_GE(w.after, 0.2);
+  EXPECT_GE(others_min(walked), w.after - 1e-12);
+  EXPECT_GE(rank_of(walked, h0), rank_of(stalled, h0) - 1e-12);
+  expect_guards(stalled, walked, "held");
+  std::printf("held hex %.4f -> %.4f; the others %.4f -> %.4f\n", rank_of(stalled, h0), rank_of(walked, h0),
+              others_min(stalled), others_min(walked));
+}
+
 // `isohex smooth --search-trials`: the walk is counted in the JSON report (the piece held at
 // its outer layer, as `--fixed file` reads it), 0 turns it off, and a negative value exits 2
 // before anything is written.

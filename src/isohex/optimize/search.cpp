@@ -45,6 +45,7 @@ class Random {
 // One hex of the region: its rank now and the floors its guards hold it to.
 struct HexState {
   double rank, sj_floor, ratio_floor, edge_cap;
+  double held;  // a held hex: its rank when the walk began (+inf for the others)
 };
 
 // The free vertices within `rings` vertex rings of `cluster` (ring by ring, stopping before
@@ -78,7 +79,7 @@ std::vector<Index> region_vertices(const HexMesh& mesh, const Incidence& inc, co
 
 SearchOutcome search_region(HexMesh& mesh, const Incidence& inc, const std::vector<std::uint8_t>& fixed,
                             const std::vector<Index>& cluster, const std::vector<Vec3>& start,
-                            const WorstOptions& options, double mesh_min) {
+                            const WorstOptions& options, double mesh_min, const std::vector<std::uint8_t>& held) {
   SearchOutcome out;
   const BoundarySurface* surface = options.surface;
   std::vector<Index> verts = region_vertices(mesh, inc, fixed, cluster, options.search_rings, options.search_vertices);
@@ -107,12 +108,15 @@ SearchOutcome search_region(HexMesh& mesh, const Incidence& inc, const std::vect
     const double e = edge_ratio(p);
     // The floors of the single moves, but the edge-ratio cap without their exception of 100 for
     // poor ratios: the walk moves every vertex of its region, not only those of a poor hex.
-    state.push_back({hex_rank(c), std::min(sj, sj_level), std::min(c.ratio_bound, options.ratio_floor),
-                     std::max(e, options.max_edge_ratio)});
+    const double r = hex_rank(c);
+    state.push_back({r, std::min(sj, sj_level), std::min(c.ratio_bound, options.ratio_floor),
+                     std::max(e, options.max_edge_ratio),
+                     !held.empty() && held[h] ? r : std::numeric_limits<double>::infinity()});
   }
   const auto region_min = [&] {
     double m = std::numeric_limits<double>::infinity();
-    for (const HexState& s : state) m = std::min(m, s.rank);
+    for (const HexState& s : state)
+      if (std::isinf(s.held)) m = std::min(m, s.rank);
     return m;
   };
   double now = out.before = out.after = region_min();
@@ -127,7 +131,7 @@ SearchOutcome search_region(HexMesh& mesh, const Incidence& inc, const std::vect
     worst.clear();
     for (std::size_t s = 0; s < verts.size(); ++s)
       for (Index k = inc.offsets[verts[s]]; k < inc.offsets[verts[s] + 1]; ++k)
-        if (state[slot(inc.ids[k])].rank < now + 0.01) {
+        if (const HexState& st = state[slot(inc.ids[k])]; std::isinf(st.held) && st.rank < now + 0.01) {
           worst.push_back(s);
           break;
         }
@@ -164,7 +168,7 @@ SearchOutcome search_region(HexMesh& mesh, const Incidence& inc, const std::vect
       const CertifiedQuality q = certified_quality(p);
       const HexState& st = state[slot(h)];
       const double sj = is_degenerate(q.scaled_jacobian) ? -2.0 : q.scaled_jacobian;
-      ok = ok && hex_rank(q) >= now && sj >= st.sj_floor && q.ratio_bound >= st.ratio_floor && edge_ratio(p) <= st.edge_cap;
+      ok = ok && hex_rank(q) >= std::min(now, st.held) && sj >= st.sj_floor && q.ratio_bound >= st.ratio_floor && edge_ratio(p) <= st.edge_cap;
       trial.push_back(q);
     }
     ++window;

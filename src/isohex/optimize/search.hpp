@@ -42,8 +42,12 @@ struct SearchOutcome {
 /// at options.search_trials steps, when every hex of the region reaches a rank of 0.2, or when
 /// the minimum has not risen for a quarter of the budget; without a gain the vertices go back
 /// where they were. Sequential with a fixed seed: the same mesh gives the same result.
+/// Hexes marked in `held` (the members of find_quality_bounds()' sets, which the fixed
+/// vertices keep below 0.2) do not count in the minimum: each only keeps the lower of its own
+/// rank and the minimum, so a hex proven stuck does not stop the walk round its neighbours.
 SearchOutcome search_region(HexMesh& mesh, const Incidence& inc, const std::vector<std::uint8_t>& fixed,
                             const std::vector<Index>& cluster, const std::vector<Vec3>& start,
-                            const WorstOptions& options, double mesh_min);
+                            const WorstOptions& options, double mesh_min,
+                            const std::vector<std::uint8_t>& held = {});
 
 }  // namespace isohex::opt
