@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 using namespace isohex;
@@ -171,6 +172,38 @@ TEST(JacobianBounds, FloorIsRespected) {
   Corners p = unit_cube();
   EXPECT_TRUE(certified_valid(p, 0.99));
   EXPECT_FALSE(certified_valid(p, 1.0));
+}
+
+// The lattice computes each edge vector once for the 27 points (bernstein_box()); its corner
+// coefficients are its values there, which must be jacobian_determinant()'s bit for bit (the
+// optimisers' results must not move with how the lattice is computed). And the shape stage's
+// one-evaluation test is the two tests it replaces, on valid, folded and flat hexes.
+TEST(JacobianBounds, LatticeAndCombinedTestAgreeExactly) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> t(0, 1);
+  std::size_t valid = 0, refused_by_ratio = 0, invalid = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    Corners p = jittered(rng, trial % 4 == 0 ? 0.45 : 0.2);
+    for (Vec3& x : p) x = 1e3 * x + Vec3(-7e4, 3e3, 1e5);  // far from the origin, as scans are
+    const Vec3 lo(0.5 * t(rng), 0.5 * t(rng), 0.5 * t(rng)), hi(0.5 + 0.5 * t(rng), 0.5 + 0.5 * t(rng), 1);
+    const auto b = jacobian_bernstein(p, lo, hi);
+    for (int c = 0; c < 8; ++c) {
+      const double u = c & 1 ? hi[0] : lo[0], v = c & 2 ? hi[1] : lo[1], w = c & 4 ? hi[2] : lo[2];
+      EXPECT_EQ(b[(c & 1 ? 2 : 0) + (c & 2 ? 6 : 0) + (c & 4 ? 18 : 0)], jacobian_determinant(p, u, v, w)) << trial;
+    }
+    const double ratio = jacobian_ratio_bound(p);
+    for (double floor : {0.0, 1e6, 5e8})
+      for (double ratio_floor : {-std::numeric_limits<double>::infinity(), 0.1, 0.4}) {
+        const bool both = !(ratio < ratio_floor) && certified_valid(p, floor);
+        EXPECT_EQ(certified_valid_above_ratio(p, floor, ratio_floor), both) << trial;
+        valid += both;
+        refused_by_ratio += ratio < ratio_floor && certified_valid(p, floor);
+        invalid += !certified_valid(p, floor);
+      }
+  }
+  EXPECT_GT(valid, 100u);  // every outcome is met
+  EXPECT_GT(refused_by_ratio, 10u);
+  EXPECT_GT(invalid, 10u);
 }
 
 TEST(VolumeBalance, BoxMatchesAndAFoldIsSeen) {

@@ -252,15 +252,14 @@ bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector
     for (int k = 0; k < 8; ++k)
       if (mesh.hexes[h][k] == v) p[k] = x;
     const auto at = static_cast<std::size_t>(i - inc.offsets[v]);
+    // Only the certificate: a finite shape energy has checked the frames v changes already,
+    // and the others are those of a hex that was feasible.
+    const double floor = kMinFeasibleDet / (inv_len[h] * inv_len[h] * inv_len[h]);
     if (rank_floor) {  // both from one evaluation of the coefficients
       const CertifiedQuality c = certified_quality(p);
       if (hex_rank(c) < (*rank_floor)[at] || (ratio_floor && c.ratio_bound < (*ratio_floor)[at])) return false;
-    } else if (ratio_floor && jacobian_ratio_bound(p) < (*ratio_floor)[at]) {
-      return false;
     }
-    // Only the certificate: a finite shape energy has checked the frames v changes already,
-    // and the others are those of a hex that was feasible.
-    if (!certified_valid(p, kMinFeasibleDet / (inv_len[h] * inv_len[h] * inv_len[h]))) return false;
+    if (!certified_valid_above_ratio(p, floor, !rank_floor && ratio_floor ? (*ratio_floor)[at] : -kInf)) return false;
   }
   return true;
 }

@@ -25,25 +25,43 @@ std::array<Vec3, 8> relative(const std::array<Vec3, 8>& p) {
   return q;
 }
 
-double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
-  const double u0 = 1 - u, v0 = 1 - v, w0 = 1 - w;
-  const Vec3 xu = v0 * w0 * (p[1] - p[0]) + v * w0 * (p[2] - p[3]) + v0 * w * (p[5] - p[4]) + v * w * (p[6] - p[7]);
-  const Vec3 xv = u0 * w0 * (p[3] - p[0]) + u * w0 * (p[2] - p[1]) + u0 * w * (p[7] - p[4]) + u * w * (p[6] - p[5]);
-  const Vec3 xw = u0 * v0 * (p[4] - p[0]) + u * v0 * (p[5] - p[1]) + u * v * (p[6] - p[2]) + u0 * v * (p[7] - p[3]);
-  return xu.dot(xv.cross(xw));
+// The three edge vectors of the trilinear map: ∂x/∂u depends on (v, w) only, ∂x/∂v on (u, w),
+// ∂x/∂w on (u, v), so a lattice of 27 points needs 9 of each (bernstein_box()).
+Vec3 edge_u(const std::array<Vec3, 8>& p, double v, double w) {
+  const double v0 = 1 - v, w0 = 1 - w;
+  return v0 * w0 * (p[1] - p[0]) + v * w0 * (p[2] - p[3]) + v0 * w * (p[5] - p[4]) + v * w * (p[6] - p[7]);
+}
+Vec3 edge_v(const std::array<Vec3, 8>& p, double u, double w) {
+  const double u0 = 1 - u, w0 = 1 - w;
+  return u0 * w0 * (p[3] - p[0]) + u * w0 * (p[2] - p[1]) + u0 * w * (p[7] - p[4]) + u * w * (p[6] - p[5]);
+}
+Vec3 edge_w(const std::array<Vec3, 8>& p, double u, double v) {
+  const double u0 = 1 - u, v0 = 1 - v;
+  return u0 * v0 * (p[4] - p[0]) + u * v0 * (p[5] - p[1]) + u * v * (p[6] - p[2]) + u0 * v * (p[7] - p[3]);
 }
 
+double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
+  return edge_u(p, v, w).dot(edge_v(p, u, w).cross(edge_w(p, u, v)));
+}
 
 // The 27 samples on the lattice of [lo, hi] and their Bernstein coefficients; `samples`
-// (values actually taken by det J) may be null.
+// (values actually taken by det J) may be null. (The same values as det_at() at each point,
+// bit for bit: its edge vectors, each computed once.)
 std::array<double, 27> bernstein_box(const std::array<Vec3, 8>& q, const Vec3& lo, const Vec3& hi,
                                      std::array<double, 27>* samples) {
   std::array<double, 27> b;
   const Vec3 mid = 0.5 * (lo + hi);
   const double us[3] = {lo[0], mid[0], hi[0]}, vs[3] = {lo[1], mid[1], hi[1]}, ws[3] = {lo[2], mid[2], hi[2]};
+  std::array<Vec3, 9> xu, xv, xw;  // xu[j + 3k] at (v_j, w_k), xv[i + 3k] at (u_i, w_k), xw[i + 3j] at (u_i, v_j)
+  for (int b2 = 0; b2 < 3; ++b2)
+    for (int a = 0; a < 3; ++a) {
+      xu[a + 3 * b2] = edge_u(q, vs[a], ws[b2]);
+      xv[a + 3 * b2] = edge_v(q, us[a], ws[b2]);
+      xw[a + 3 * b2] = edge_w(q, us[a], vs[b2]);
+    }
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) b[i + 3 * j + 9 * k] = det_at(q, us[i], vs[j], ws[k]);
+      for (int i = 0; i < 3; ++i) b[i + 3 * j + 9 * k] = xu[j + 3 * k].dot(xv[i + 3 * k].cross(xw[i + 3 * j]));
   if (samples) *samples = b;
   lattice_to_bernstein(b);
   return b;
@@ -246,6 +264,13 @@ double gauss_min_jacobian(const std::array<Vec3, 8>& p) {
   for (int c = 0; c < 8; ++c)
     m = std::min(m, det_at(q, c & 1 ? 1 - kG2 : kG2, c & 2 ? 1 - kG2 : kG2, c & 4 ? 1 - kG2 : kG2));
   return m;
+}
+
+bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor) {
+  const std::array<Vec3, 8> q = relative(p);
+  std::array<double, 27> s;
+  const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
+  return !(ratio_bound(b) < ratio_floor) && certify(q, b, s, floor, kCertifySubdivisions);
 }
 
 bool certified_valid(const std::array<Vec3, 8>& p, double floor, int max_subdivisions) {

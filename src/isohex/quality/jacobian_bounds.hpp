@@ -96,6 +96,10 @@ double certified_scaled_jacobian(const std::array<Vec3, 8>& p);
 /// every trial move); <= 0 when the coefficients do not certify the element.
 double jacobian_ratio_bound(const std::array<Vec3, 8>& p);
 
+/// `!(jacobian_ratio_bound(p) < ratio_floor) && certified_valid(p, floor)` from one evaluation
+/// of the coefficients (each line-search step of the shape stage tests both, hex by hex).
+bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor);
+
 // ---- whole meshes ---------------------------------------------------------------------
 
 /// Per-hex certified validity, ratio and Gauss-point minimum, in hex order (parallel,
