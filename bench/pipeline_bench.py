@@ -21,15 +21,15 @@ import sys
 import tempfile
 import time
 
-CTHEAD = ["--dims", "256", "256", "113", "--type", "i16", "--endian", "big", "--spacing", "1", "1", "2", "--iso", "600"]
-HEADSQ = ["--dims", "64", "64", "93", "--type", "i16", "--spacing", "3.2", "3.2", "1.5", "--iso", "1150"]
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scripts"))
+from paper_table import CTHEAD, HEADSQ  # noqa: E402  (the scans' layouts, one list for both)
 
 
 def cases(data):
     v = lambda f: os.path.join(data, "volumes", f)
-    out = [(f"cthead h {h}", [v("cthead_256x256x113_int16be.raw")] + CTHEAD + ["--cell-size", str(h)])
+    out = [(f"cthead h {h}", [v("cthead_256x256x113_int16be.raw")] + CTHEAD + ["--iso", "600", "--cell-size", str(h)])
            for h in (4, 3, 2)]
-    out += [("headsq h 3.2", [v("headsq_64x64x93_int16le.raw")] + HEADSQ + ["--cell-size", "3.2"]),
+    out += [("headsq h 3.2", [v("headsq_64x64x93_int16le.raw")] + HEADSQ + ["--iso", "1150", "--cell-size", "3.2"]),
             ("MR head h 4", [v("HeadMRVolume.mhd"), "--iso", "40", "--cell-size", "4"])]
     phantom = "difference(union(sphere(0,0,0,1), torus(0,0,0, 1.2,0.35)), sphere(0,0,0,0.55))"
     return [(n, a) for n, a in out if os.path.exists(a[0])] + [("CSG phantom (scripts/run.sh)",

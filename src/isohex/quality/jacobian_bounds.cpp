@@ -266,18 +266,26 @@ double gauss_min_jacobian(const std::array<Vec3, 8>& p) {
   return m;
 }
 
-bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor) {
+namespace {
+
+// certified_valid() with, unless ratio_floor is -inf, the ratio floor tested first on the same
+// coefficients.
+bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivisions, double ratio_floor) {
   const std::array<Vec3, 8> q = relative(p);
   std::array<double, 27> s;
   const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
-  return !(ratio_bound(b) < ratio_floor) && certify(q, b, s, floor, kCertifySubdivisions);
+  if (ratio_floor > -std::numeric_limits<double>::infinity() && ratio_bound(b) < ratio_floor) return false;
+  return certify(q, b, s, floor, max_subdivisions);
+}
+
+}  // namespace
+
+bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor) {
+  return certified_above(p, floor, kCertifySubdivisions, ratio_floor);
 }
 
 bool certified_valid(const std::array<Vec3, 8>& p, double floor, int max_subdivisions) {
-  const std::array<Vec3, 8> q = relative(p);
-  std::array<double, 27> s;
-  const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
-  return certify(q, b, s, floor, max_subdivisions);
+  return certified_above(p, floor, max_subdivisions, -std::numeric_limits<double>::infinity());
 }
 
 double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
