@@ -37,7 +37,7 @@ struct Args {
   double feature_angle = 30;
   FixedVertices fixed = FixedVertices::boundary;
   std::optional<int> max_iter;  ///< unset: each stage's own limit (untangle 200, shape 100)
-  double tol = 1e-5, margin = 0.05;
+  double tol = 1e-4, margin = 0.05;
   double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
   int patch_rounds = WorstOptions{}.patch_rounds;  ///< --patch-rounds
   int worst_passes = WorstOptions{}.passes;        ///< --worst-passes
@@ -231,7 +231,7 @@ void register_smooth(CLI::App& app) {
   cmd->add_option("--max-iter", a->max_iter,
                   "Iteration limit of the untangler and the shape stage (default 200 and 100; the untangler "
                   "usually stops earlier, when it stalls)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--tol", a->tol, "Stop the shape stage below this relative improvement per sweep (default 1e-5)")
+  cmd->add_option("--tol", a->tol, "Stop the shape stage below this relative improvement per sweep (default 1e-4)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--margin", a->margin, "Untangling target for the minimum scaled Jacobian (default 0.05)");
   cmd->add_flag("--no-worst", a->no_worst, "Skip the worst-element pass");

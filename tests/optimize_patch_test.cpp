@@ -157,3 +157,29 @@ TEST(OptimizePatch, CliSmoothCountsJointMovesAndRefusesABadValue) {
   EXPECT_EQ(test::smooth_piece_count("bone_cluster.txt", " --patch-rounds 0", "patch_moves"), 0u);
   test::expect_smooth_refuses("bone_cluster.txt", "--patch-rounds", "-1");
 }
+
+// The single passes' stall stop (WorstOptions::stall_passes) ends them where ten passes gain
+// less than stall_gain; it cuts the run short and changes nothing else: the same passes without
+// the stop give the same mesh, bit for bit, and running on to the end gains little.
+TEST(OptimizePatch, SinglePassesStopWhenTheyStall) {
+  std::vector<Index> targets;
+  const HexMesh before = test::read_piece("bone_stall.txt", targets, true);  // single moves creep on here
+  WorstOptions single;
+  single.patch_rounds = 0;
+  single.search_trials = 0;
+  single.passes = 1000;
+  HexMesh stopped = before;
+  const WorstResult s = improve_worst(stopped, stopped.fixed, single);
+  single.stall_passes = 0;
+  HexMesh full = before;
+  const WorstResult f = improve_worst(full, full.fixed, single);
+  EXPECT_LT(s.passes, f.passes);
+  single.passes = s.passes;
+  HexMesh prefix = before;
+  improve_worst(prefix, prefix.fixed, single);
+  EXPECT_EQ(prefix.points, stopped.points);
+  EXPECT_GE(s.min_sj_after, s.min_sj_before);
+  EXPECT_GT(lowest_rank(stopped, targets), lowest_rank(full, targets) - 0.01);
+  std::printf("stopped after %d passes at %.4f; to the end %d passes, %.4f\n", s.passes, lowest_rank(stopped, targets),
+              f.passes, lowest_rank(full, targets));
+}

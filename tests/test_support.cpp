@@ -100,6 +100,7 @@ WorstResult stall_single_moves(HexMesh& m, int passes) {
   single.patch_rounds = 0;
   single.search_trials = 0;
   single.passes = passes;
+  single.stall_passes = 0;  // until no single move gains, not until they gain little
   return improve_worst(m, m.fixed, single);
 }
 

@@ -204,7 +204,8 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
 /// Options of the shape optimiser.
 struct ShapeOptions {
   int max_iter = 100;        ///< Gauss–Seidel sweeps
-  double tol = 1e-5;         ///< stop when a sweep lowers the objective by less than tol (relative)
+  double tol = 1e-4;         ///< stop when a sweep lowers the objective by less than tol (relative) ...
+  double min_sj_gain = 1e-3; ///< ... and raises the smallest certified scaled Jacobian by less than this
   double grad_tol = 1e-8;    ///< ... or when the largest vertex gradient (× edge length) is below this
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   /// No step takes a hex's rank, the lower of its certified scaled Jacobian and twice its
@@ -236,6 +237,13 @@ struct WorstOptions {
   std::size_t count = 100;  ///< ... at most this many of the worst,
   double raise_below = 0.3; ///< ... and on those of every hex below this (the questionable ones and a margin)
   int passes = 30;
+  /// ... stopping early when the last `stall_passes` passes together raised the lowest rank by
+  /// less than `stall_gain` and, while hexes are below 0.2 by rank, lowered their deficit (the
+  /// sum of 0.2 - rank over them) by less than `stall_fraction` of it, or else raised the mean
+  /// of the `count` lowest ranks by less than `stall_gain` (0: no such stop).
+  int stall_passes = 10;
+  double stall_gain = 1e-3;
+  double stall_fraction = 0.01;
   /// A move of a vertex: the max–min LP step within a box of half-side `step` × its mean edge
   /// length, halved up to `trials` times until the true values gain, the model rebuilt up to
   /// `models` times at the new place.

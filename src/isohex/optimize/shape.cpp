@@ -43,6 +43,7 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   const VertexColoring coloring = color_vertices(mesh, fixed);
   double e = mean_objective(mesh, inv_len, bad);
   res.objective_before = res.objective_after = e;
+  double min_sj = opt::sj_stats(mesh).min;
   for (int it = 1; it <= options.max_iter; ++it) {
     opt::EnergyParams params;
     params.surface = options.surface;
@@ -52,13 +53,15 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
     res.iterations = it;
     res.history.push_back(e_new);
     res.objective_after = e_new;
-    if (options.progress) {
-      const opt::SJStats s = opt::sj_stats(mesh);
-      options.progress({"shape", it, e_new, s.min, s.inverted});
-    }
+    const opt::SJStats s = opt::sj_stats(mesh);
+    if (options.progress) options.progress({"shape", it, e_new, s.min, s.inverted});
     const double rel = (e - e_new) / e;
+    const double sj_gain = s.min - min_sj;
     e = e_new;
-    if (rel < options.tol || grad < options.grad_tol) break;
+    min_sj = s.min;
+    // The objective alone would stop while the minimum still climbs (Mesquite's pave1: 0.12
+    // after 42 sweeps at 1e-4, 0.39 after 78), and the minimum is what the user sees.
+    if ((rel < options.tol && !(sj_gain >= options.min_sj_gain)) || grad < options.grad_tol) break;
   }
   return res;
 }
