@@ -140,7 +140,10 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
                   {"search_gains", w.search_gains},
                   {"min_sj_before", w.min_sj_before},
                   {"min_sj_after", w.min_sj_after},
-                  {"seconds", r.worst_seconds}};
+                  {"seconds", r.worst_seconds},
+                  {"passes_seconds", w.passes_seconds},
+                  {"patch_seconds", w.patch_seconds},
+                  {"search_seconds", w.search_seconds}};
     // The hexes no placement of the free vertices lifts to 0.2, proven (find_quality_bounds()).
     auto& proven = j["worst"]["proven"] = nlohmann::json::array();
     for (const QualityBound& b : w.proven)

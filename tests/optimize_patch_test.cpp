@@ -174,6 +174,9 @@ TEST(OptimizePatch, SinglePassesStopWhenTheyStall) {
   HexMesh full = before;
   const WorstResult f = improve_worst(full, full.fixed, single);
   EXPECT_LT(s.passes, f.passes);
+  EXPECT_GT(s.passes_seconds, 0.0);  // all of its time, with no joint moves and no walk
+  EXPECT_EQ(s.patch_seconds, 0.0);
+  EXPECT_EQ(s.search_seconds, 0.0);
   single.passes = s.passes;
   HexMesh prefix = before;
   improve_worst(prefix, prefix.fixed, single);

@@ -310,6 +310,8 @@ struct WorstResult {
   std::size_t patch_moves = 0;  ///< joint moves of patches (WorstOptions::patch_rounds)
   std::size_t searched = 0, search_gains = 0;  ///< clusters the random search ran on, and raised
   double min_sj_before = 0, min_sj_after = 0;
+  /// Wall seconds of the single passes, the joint moves of patches and the random walks.
+  double passes_seconds = 0, patch_seconds = 0, search_seconds = 0;
   /// With fixed vertices and hexes still below 0.2 at the end: find_quality_bounds() at 0.2, the
   /// sets of hexes that no placement of the free vertices lifts all to 0.2. A hex below 0.2 in
   /// none of them is the pass's own shortfall.

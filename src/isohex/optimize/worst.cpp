@@ -11,6 +11,7 @@
 #include "isohex/quality/summary.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -348,7 +349,9 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
       for (Index w : mesh.hexes[inc.ids[k]]) settled[w] = 0;
   };
-  const auto single_passes = [&](int passes) {
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  const auto untimed_passes = [&](int passes) {
     std::fill(settled.begin(), settled.end(), 0);  // patches and walks moved vertices in between
     std::vector<Standing> history{standing()};
     for (int end = pass + passes; pass < end;) {
@@ -397,6 +400,11 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       }
     }
   };
+  const auto single_passes = [&](int passes) {
+    const auto t0 = Clock::now();
+    untimed_passes(passes);
+    res.passes_seconds += since(t0);
+  };
   single_passes(options.passes);
   // The end game: each cluster of hexes still below 0.2 by rank with the free vertices of its
   // hexes moved together, or where that gains nothing those of its worst hex (or of the hexes
@@ -434,6 +442,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     return n > options.patch_max_poor;
   };
   for (int round = 0; round < options.patch_rounds; ++round) {
+    const auto t0 = Clock::now();
     sort_worst_first();
     if (too_many_poor(poor)) break;
     std::fill(clustered.begin(), clustered.end(), 0);
@@ -459,6 +468,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       moved += try_patch(cluster) || (cluster.size() > 1 && try_patch({h})) || try_star(h);
     }
     res.patch_moves += moved;
+    res.patch_seconds += since(t0);
     res.min_sj_after = mesh_min();
     if (options.progress) options.progress({"patch", round + 1, static_cast<double>(moved), res.min_sj_after, 0});
     if (moved == 0) break;
@@ -474,8 +484,10 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     for (std::size_t i = 0; i < order.size() && poor(order[i]); ++i) {
       const Index h = order[i];
       if (clustered[h] || !member(h)) continue;
+      const auto t0 = Clock::now();
       const opt::SearchOutcome o =
           opt::search_region(mesh, inc, fixed, cluster_of(h, member), start, options, mesh_min(), hold);
+      res.search_seconds += since(t0);
       ++res.searched;
       if (!(o.after > o.before)) continue;
       ++gains;
