@@ -37,7 +37,7 @@ struct Args {
   double feature_angle = 30;
   FixedVertices fixed = FixedVertices::boundary;
   std::optional<int> max_iter;  ///< unset: each stage's own limit (untangle 200, shape 100)
-  double tol = 1e-4, margin = 0.05;
+  double tol = ShapeOptions{}.tol, margin = 0.05;
   double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
   int patch_rounds = WorstOptions{}.patch_rounds;  ///< --patch-rounds
   int worst_passes = WorstOptions{}.passes;        ///< --worst-passes

@@ -321,23 +321,20 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return rank[a] < rank[b]; });
   };
   int pass = 0;
-  // What a pass is judged by: the lowest rank, the deficit of the hexes below 0.2 by rank (the
-  // sum of their distances to 0.2), and the mean of the `count` lowest ranks (the tail it
-  // raises once none is below 0.2).
+  // What a pass is judged by, read off `order` (sorted worst first): the lowest rank, the
+  // deficit of the hexes below 0.2 by rank (the sum of their distances to 0.2), and the mean of
+  // the `count` lowest ranks (the tail it raises once none is below 0.2).
   struct Standing {
     double min = 2, deficit = 0, tail = 0;
   };
-  std::vector<double> lowest;
   const auto standing = [&] {
     Standing s;
-    for (double r : rank) s.deficit += std::max(0.0, kQuestionableSJ - r);
-    lowest = rank;
-    const std::size_t k = std::min(std::max<std::size_t>(options.count, 1), lowest.size());
+    const std::size_t k = std::min(std::max<std::size_t>(options.count, 1), order.size());
     if (k == 0) return s;
-    const auto kth = lowest.begin() + static_cast<std::ptrdiff_t>(k - 1);
-    std::nth_element(lowest.begin(), kth, lowest.end());
-    s.min = *std::min_element(lowest.begin(), kth + 1);
-    for (auto it = lowest.begin(); it != kth + 1; ++it) s.tail += *it / static_cast<double>(k);
+    s.min = rank[order[0]];
+    for (std::size_t i = 0; i < k; ++i) s.tail += rank[order[i]] / static_cast<double>(k);
+    for (std::size_t i = 0; i < order.size() && rank[order[i]] < kQuestionableSJ; ++i)
+      s.deficit += kQuestionableSJ - rank[order[i]];
     return s;
   };
   // A vertex whose move found no gain is not tried again until a vertex of a hex around it
@@ -353,11 +350,24 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   const auto untimed_passes = [&](int passes) {
     std::fill(settled.begin(), settled.end(), 0);  // patches and walks moved vertices in between
-    std::vector<Standing> history{standing()};
+    std::vector<Standing> history;
     for (int end = pass + passes; pass < end;) {
+      sort_worst_first();
+      // A stall: tiny gains go on for ever (a move is kept for any rise of its own
+      // minimum), so the passes stop once `stall_passes` of them together gained little by
+      // the standing: the minimum, and the deficit below 0.2 while there is one, else the
+      // tail (cthead h 4: 100 passes at a minimum of 0.163 that only the walk raised; with the
+      // minimum alone, pave1 fixed ended at 0.303 instead of 0.403).
+      history.push_back(standing());
+      if (options.stall_passes > 0 && history.size() > static_cast<std::size_t>(options.stall_passes)) {
+        const Standing& then = history[history.size() - 1 - static_cast<std::size_t>(options.stall_passes)];
+        const Standing& now = history.back();
+        const bool stalled = then.deficit > 0 ? now.deficit >= (1 - options.stall_fraction) * then.deficit
+                                              : now.tail < then.tail + options.stall_gain;
+        if (stalled && now.min < then.min + options.stall_gain) break;
+      }
       // Sequential: deterministic, and cheap since only a few hundred vertices take part.
       ++pass;
-      sort_worst_first();
       std::size_t moved = 0;
       const double min_now = mesh_min();
       for (std::size_t i = 0;
@@ -385,19 +395,6 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
         options.progress({"worst", pass, static_cast<double>(moved), res.min_sj_after, inverted});
       }
       if (moved == 0) break;
-      // A stall: tiny gains go on for ever (a move is kept for any rise of its own
-      // minimum), so the passes stop once `stall_passes` of them together gained little by
-      // the standing: the minimum, and the deficit below 0.2 while there is one, else the
-      // tail (cthead h 4: 100 passes at a minimum of 0.163 that only the walk raised; with the
-      // minimum alone, pave1 fixed ended at 0.303 instead of 0.403).
-      history.push_back(standing());
-      if (options.stall_passes > 0 && history.size() > static_cast<std::size_t>(options.stall_passes)) {
-        const Standing& then = history[history.size() - 1 - static_cast<std::size_t>(options.stall_passes)];
-        const Standing& now = history.back();
-        const bool stalled = then.deficit > 0 ? now.deficit >= (1 - options.stall_fraction) * then.deficit
-                                              : now.tail < then.tail + options.stall_gain;
-        if (stalled && now.min < then.min + options.stall_gain) break;
-      }
     }
   };
   const auto single_passes = [&](int passes) {
