@@ -244,7 +244,8 @@ bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len) {
 
 bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                     const Vec3& x, const std::vector<std::uint8_t>* skip, const std::vector<double>* ratio_floor,
-                    const std::vector<double>* rank_floor) {
+                    const std::vector<double>* rank_floor, std::vector<double>* ratios) {
+  if (ratios) ratios->clear();
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     if (skip && (*skip)[h]) continue;
@@ -259,7 +260,11 @@ bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector
       const CertifiedQuality c = certified_quality(p);
       if (hex_rank(c) < (*rank_floor)[at] || (ratio_floor && c.ratio_bound < (*ratio_floor)[at])) return false;
     }
-    if (!certified_valid_above_ratio(p, floor, !rank_floor && ratio_floor ? (*ratio_floor)[at] : -kInf)) return false;
+    double ratio = 0;
+    const bool ok = certified_valid_above_ratio(p, floor, !rank_floor && ratio_floor ? (*ratio_floor)[at] : -kInf,
+                                                ratios ? &ratio : nullptr);
+    if (ratios) ratios->push_back(ratio);
+    if (!ok) return false;
   }
   return true;
 }
@@ -349,12 +354,17 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   // and the guard: the rounds' shape stage took cthead's bone (iso 1200, h 5) from 0.124 to
   // 0.093 and the worst pass won back less each round.
   const bool guarded = !params.untangle && params.rank_guard > -kInf;
-  std::vector<double> ratio_floor, rank_floor;
+  // The ratio bounds kept per hex (EnergyParams::hex_ratio) save a certificate's coefficients
+  // per hex and move: a move's floors read them, its accepted step writes those it computed.
+  std::vector<double>* cache = !params.untangle && !guarded && !params.skip ? params.hex_ratio : nullptr;
+  std::vector<double> ratio_floor, rank_floor, ratios;
   if (!params.untangle)
     for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
-      const auto p = mesh.corners(inc.ids[i]);
+      const Index h = inc.ids[i];
       // The scaled Jacobian and its certificate only where the guard needs them.
-      const CertifiedQuality c = guarded ? certified_quality(p) : CertifiedQuality{0, jacobian_ratio_bound(p)};
+      const CertifiedQuality c = guarded ? certified_quality(mesh.corners(h))
+                                         : CertifiedQuality{0, cache ? (*cache)[static_cast<std::size_t>(h)]
+                                                                     : jacobian_ratio_bound(mesh.corners(h))};
       ratio_floor.push_back(c.ratio_bound >= kShapeRatioFloor ? kShapeRatioFloor : -kInf);
       if (guarded) rank_floor.push_back(std::min(hex_rank(c), params.rank_guard));
     }
@@ -365,10 +375,14 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
     const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
     // The shape stage's barrier sees the 9 frames only: a step must also keep every hex
     // around v certified valid inside (hex_feasible()), or a fold could open between them.
-    if (e < e0 && e <= e0 + 1e-4 * t * slope && (params.untangle || stays_feasible(mesh, inc, inv_len, v, x, params.skip, &ratio_floor,
-                                                                                       guarded ? &rank_floor : nullptr))) {
+    if (e < e0 && e <= e0 + 1e-4 * t * slope &&
+        (params.untangle || stays_feasible(mesh, inc, inv_len, v, x, params.skip, &ratio_floor,
+                                           guarded ? &rank_floor : nullptr, cache ? &ratios : nullptr))) {
       m.x = x;
       m.moved = true;
+      if (cache)
+        for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+          (*cache)[static_cast<std::size_t>(inc.ids[i])] = ratios[static_cast<std::size_t>(i - inc.offsets[v])];
       break;
     }
   }

@@ -64,6 +64,11 @@ struct EnergyParams {
   const std::vector<std::uint8_t>* bernstein = nullptr;
   /// Whether hex h counts its Bernstein coefficients (untangle only).
   bool bernstein_of(Index h) const { return untangle && bernstein && (*bernstein)[static_cast<std::size_t>(h)]; }
+  /// shape: each hex's jacobian_ratio_bound() where it stands (may be null: computed per move).
+  /// newton_move() reads the floors of its line search from it and, moving, stores the values
+  /// at the place it returns (which the caller then takes), so it stays exact through a
+  /// sweep; unused with a rank guard or `skip`.
+  std::vector<double>* hex_ratio = nullptr;
   /// The number of frames hex h contributes.
   int frames_of(Index h) const { return interior && (*interior)[static_cast<std::size_t>(h)] ? kAllFrames : kFrames; }
   /// shape: no step takes a hex's rank (hex_rank()) below the lower of its rank before the step
@@ -109,10 +114,12 @@ bool hex_feasible(const std::array<Vec3, 8>& p, double inv_len);
 /// changes are feasible) from a place where every hex around v is hex_feasible().
 /// With `ratio_floor` (one value per hex around v, in incidence order), also that no hex's
 /// jacobian_ratio_bound() falls below its floor; with `rank_floor` (the same), that no hex's
-/// hex_rank() does.
+/// hex_rank() does. With `ratios` (no rank_floor, no skip), each hex's jacobian_ratio_bound()
+/// with v at x, in the same order, complete when the answer is true.
 bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                     const Vec3& x, const std::vector<std::uint8_t>* skip,
-                    const std::vector<double>* ratio_floor = nullptr, const std::vector<double>* rank_floor = nullptr);
+                    const std::vector<double>* ratio_floor = nullptr, const std::vector<double>* rank_floor = nullptr,
+                    std::vector<double>* ratios = nullptr);
 
 /// The ratio terms are weighted this against the scaled Jacobian's frame values: 2 puts a ratio
 /// of 0.1 (poor, kPoorJacobianRatio) level with a scaled Jacobian of 0.2.

@@ -1,6 +1,10 @@
 // Inverse mean-ratio shape optimisation (Knupp 2003) by feasible per-vertex Newton steps.
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace isohex {
 
@@ -44,10 +48,15 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   double e = mean_objective(mesh, inv_len, bad);
   res.objective_before = res.objective_after = e;
   double min_sj = opt::sj_stats(mesh).min;
+  std::vector<double> ratio(mesh.hexes.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h) ratio[h] = jacobian_ratio_bound(mesh.corners(static_cast<Index>(h)));
+  });
   for (int it = 1; it <= options.max_iter; ++it) {
     opt::EnergyParams params;
     params.surface = options.surface;
     params.rank_guard = options.rank_guard;
+    params.hex_ratio = &ratio;
     const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 1);
     const double e_new = mean_objective(mesh, inv_len, bad);
     res.iterations = it;

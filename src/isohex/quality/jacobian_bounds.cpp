@@ -269,19 +269,21 @@ double gauss_min_jacobian(const std::array<Vec3, 8>& p) {
 namespace {
 
 // certified_valid() with, unless ratio_floor is -inf, the ratio floor tested first on the same
-// coefficients.
-bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivisions, double ratio_floor) {
+// coefficients; `ratio` (may be null) gets their ratio bound.
+bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivisions, double ratio_floor,
+                     double* ratio = nullptr) {
   const std::array<Vec3, 8> q = relative(p);
   std::array<double, 27> s;
   const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
-  if (ratio_floor > -std::numeric_limits<double>::infinity() && ratio_bound(b) < ratio_floor) return false;
+  if (ratio) *ratio = ratio_bound(b);
+  if (ratio_floor > -std::numeric_limits<double>::infinity() && (ratio ? *ratio : ratio_bound(b)) < ratio_floor) return false;
   return certify(q, b, s, floor, max_subdivisions);
 }
 
 }  // namespace
 
-bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor) {
-  return certified_above(p, floor, kCertifySubdivisions, ratio_floor);
+bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor, double* ratio) {
+  return certified_above(p, floor, kCertifySubdivisions, ratio_floor, ratio);
 }
 
 bool certified_valid(const std::array<Vec3, 8>& p, double floor, int max_subdivisions) {

@@ -97,8 +97,10 @@ double certified_scaled_jacobian(const std::array<Vec3, 8>& p);
 double jacobian_ratio_bound(const std::array<Vec3, 8>& p);
 
 /// `!(jacobian_ratio_bound(p) < ratio_floor) && certified_valid(p, floor)` from one evaluation
-/// of the coefficients (each line-search step of the shape stage tests both, hex by hex).
-bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor);
+/// of the coefficients (each line-search step of the shape stage tests both, hex by hex). With
+/// `ratio`, jacobian_ratio_bound(p) is stored there (the same bits) whatever the answer.
+bool certified_valid_above_ratio(const std::array<Vec3, 8>& p, double floor, double ratio_floor,
+                                 double* ratio = nullptr);
 
 // ---- whole meshes ---------------------------------------------------------------------
 
