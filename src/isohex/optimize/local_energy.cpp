@@ -358,6 +358,8 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   // per hex and move: a move's floors read them, its accepted step writes those it computed.
   std::vector<double>* cache = !params.untangle && !guarded && !params.skip ? params.hex_ratio : nullptr;
   std::vector<double> ratio_floor, rank_floor, ratios;
+  ratio_floor.reserve(static_cast<std::size_t>(inc.count(v)));
+  if (cache) ratios.reserve(static_cast<std::size_t>(inc.count(v)));
   if (!params.untangle)
     for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
       const Index h = inc.ids[i];

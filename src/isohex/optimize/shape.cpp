@@ -6,6 +6,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <limits>
+
 namespace isohex {
 
 namespace {
@@ -48,15 +50,18 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   double e = mean_objective(mesh, inv_len, bad);
   res.objective_before = res.objective_after = e;
   double min_sj = opt::sj_stats(mesh).min;
-  std::vector<double> ratio(mesh.hexes.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
+  // Each hex's ratio bound, kept through the sweeps (EnergyParams::hex_ratio); a rank guard
+  // reads the scaled Jacobian too, so its moves compute both and keep none.
+  const bool keep_ratios = !(options.rank_guard > -std::numeric_limits<double>::infinity());
+  std::vector<double> ratio(keep_ratios ? mesh.hexes.size() : 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ratio.size()), [&](const auto& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h) ratio[h] = jacobian_ratio_bound(mesh.corners(static_cast<Index>(h)));
   });
   for (int it = 1; it <= options.max_iter; ++it) {
     opt::EnergyParams params;
     params.surface = options.surface;
     params.rank_guard = options.rank_guard;
-    params.hex_ratio = &ratio;
+    params.hex_ratio = keep_ratios ? &ratio : nullptr;
     const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 1);
     const double e_new = mean_objective(mesh, inv_len, bad);
     res.iterations = it;

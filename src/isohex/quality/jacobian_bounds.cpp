@@ -275,8 +275,10 @@ bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivi
   const std::array<Vec3, 8> q = relative(p);
   std::array<double, 27> s;
   const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
-  if (ratio) *ratio = ratio_bound(b);
-  if (ratio_floor > -std::numeric_limits<double>::infinity() && (ratio ? *ratio : ratio_bound(b)) < ratio_floor) return false;
+  const bool wanted = ratio || ratio_floor > -std::numeric_limits<double>::infinity();
+  const double rb = wanted ? ratio_bound(b) : 0.0;
+  if (ratio) *ratio = rb;
+  if (wanted && rb < ratio_floor) return false;
   return certify(q, b, s, floor, max_subdivisions);
 }
 
