@@ -205,20 +205,20 @@ std::vector<double> inverse_edge_lengths(const HexMesh& mesh) {
   return inv;
 }
 
-Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
-  Mat3 A;
-  if (t < 8) {
-    const auto& nb = kCornerNeighbors[t];
-    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
-  } else if (t >= kFrames) {
-    A.setZero();
-    for (int k = 0; k < 8; ++k) A += (p[k] - p[0]) * kCoef[t][k].transpose();  // Σ c_k = 0: relative to P0
-    A *= inv_len;
-  } else {
-    A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
-    A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
-    A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
+Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+  // Σ_k (P_k − P_0) c_{t,k}ᵀ (Σ c_k = 0: relative to P0), entry by entry in k order, then
+  // scaled: the arithmetic of the matrix expression, without its temporaries on the stack.
+  double a[3][3] = {};
+  const auto& coef = kCoef[static_cast<std::size_t>(t)];
+  for (int k = 0; k < 8; ++k) {
+    const double d[3] = {p[k][0] - p[0][0], p[k][1] - p[0][1], p[k][2] - p[0][2]};
+    const Vec3& c = coef[static_cast<std::size_t>(k)];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) a[i][j] += d[i] * c[j];
   }
+  Mat3 A;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;
   return A;
 }
 
@@ -391,17 +391,30 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   return m;
 }
 
-double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, const EnergyParams& params,
-                    const std::vector<std::uint8_t>& skip) {
-  std::vector<double> e(mesh.hexes.size(), 0.0);
+void hex_energies(const HexMesh& mesh, const std::vector<double>& inv_len, const EnergyParams& params,
+                  const std::vector<std::uint8_t>& skip, std::vector<double>& e, const std::vector<std::uint8_t>* only) {
+  e.resize(mesh.hexes.size(), 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
-    for (std::size_t h = r.begin(); h != r.end(); ++h)
-      if (skip.empty() || !skip[h])
-        e[h] = hex_energy(mesh.corners(static_cast<Index>(h)), static_cast<Index>(h), inv_len[h], params);
+    for (std::size_t h = r.begin(); h != r.end(); ++h) {
+      if (only && !(*only)[h]) continue;
+      e[h] = !skip.empty() && skip[h]
+                 ? 0.0
+                 : hex_energy(mesh.corners(static_cast<Index>(h)), static_cast<Index>(h), inv_len[h], params);
+    }
   });
+}
+
+double energy_sum(const std::vector<double>& e) {
   double sum = 0;
   for (double x : e) sum += x;  // in hex order: the same bits for any thread count
   return sum;
+}
+
+double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, const EnergyParams& params,
+                    const std::vector<std::uint8_t>& skip) {
+  std::vector<double> e;
+  hex_energies(mesh, inv_len, params, skip, e);
+  return energy_sum(e);
 }
 
 double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc, const std::vector<double>& inv_len,

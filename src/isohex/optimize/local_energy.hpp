@@ -89,8 +89,26 @@ const std::array<int, 27>& lattice_frames();
 /// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
 std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
 
-/// Frame t of corners p (already the hex's corners), scaled by inv_len.
-Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len);
+/// Frame t >= kFrames (inside the element) of corners p, scaled by inv_len: see frame().
+Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
+
+/// Frame t of corners p (already the hex's corners), scaled by inv_len. Inline: the energy's
+/// inner loop calls it for every frame, and an out-of-line call returned the matrix through
+/// memory that the next instruction read back (a tenth of vertex_energy()'s time).
+inline Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+  Mat3 A;
+  if (t < 8) {
+    const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
+    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
+  } else if (t == kCentreFrame) {
+    A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
+    A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
+    A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
+  } else {
+    A = interior_frame(p, t, inv_len);
+  }
+  return A;
+}
 
 /// The coefficient c_{t,k} of corner k in frame t (zero when frame t does not use corner k).
 const Vec3& frame_coefficient(int t, int k);
@@ -155,6 +173,14 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
 /// `skip` (may be empty) leaves hexes out.
 double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, const EnergyParams& params,
                     const std::vector<std::uint8_t>& skip = {});
+
+/// Each hex's energy into e (sized to the hexes; 0 for hexes in `skip`), in parallel; with
+/// `only`, just the hexes flagged there (the others keep their values). Summed in hex order
+/// (energy_sum()) it is total_energy(), bit for bit.
+void hex_energies(const HexMesh& mesh, const std::vector<double>& inv_len, const EnergyParams& params,
+                  const std::vector<std::uint8_t>& skip, std::vector<double>& e,
+                  const std::vector<std::uint8_t>* only = nullptr);
+double energy_sum(const std::vector<double>& e);
 
 /// One Gauss–Seidel sweep: colours in order, the vertices of a colour in parallel, each taking
 /// `steps` Newton moves. Vertices with frozen[v] set do not move (frozen may be empty).

@@ -17,12 +17,14 @@ namespace isohex {
 namespace {
 
 // The smallest normalised frame determinant of each hex (+1e300 for skipped hexes), over the
-// frames its energy counts.
-std::vector<double> hex_min_det(const HexMesh& mesh, const std::vector<double>& inv_len,
-                                const std::vector<std::uint8_t>* skip, const opt::EnergyParams& params) {
-  std::vector<double> d(mesh.hexes.size(), 1e300);
+// frames its energy counts, into d (sized to the hexes); with `only`, of the hexes flagged there.
+void hex_min_det(const HexMesh& mesh, const std::vector<double>& inv_len, const std::vector<std::uint8_t>* skip,
+                 const opt::EnergyParams& params, std::vector<double>& d, const std::vector<std::uint8_t>* only) {
+  d.resize(mesh.hexes.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h) {
+      if (only && !(*only)[h]) continue;
+      d[h] = 1e300;
       if (skip && (*skip)[h]) continue;
       const auto p = mesh.corners(static_cast<Index>(h));
       const int frames = params.frames_of(static_cast<Index>(h));
@@ -34,7 +36,25 @@ std::vector<double> hex_min_det(const HexMesh& mesh, const std::vector<double>& 
       }
     }
   });
-  return d;
+}
+
+// The hexes with a vertex that is not frozen: the only ones a sweep can change.
+std::vector<std::uint8_t> touched_hexes(const HexMesh& mesh, const std::vector<std::uint8_t>& frozen) {
+  std::vector<std::uint8_t> t(mesh.hexes.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size()), [&](const auto& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h)
+      for (Index v : mesh.hexes[h])
+        if (!frozen[v]) t[h] = 1;
+  });
+  return t;
+}
+
+// certified_scaled_jacobian() of the hexes flagged in `only`, into sj.
+void update_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::vector<double>& sj) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 1024), [&](const auto& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h)
+      if (only[h]) sj[h] = certified_scaled_jacobian(mesh.corners(static_cast<Index>(h)));
+  });
 }
 
 // opt::sj_stats from scaled Jacobians already computed.
@@ -168,16 +188,27 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   std::vector<Vec3> best_points = mesh.points;
   opt::SJStats best = stats;
   res.stop = "max_iter";
+  // Per iteration only the hexes a sweep can change (touched_hexes()) are evaluated again after
+  // it: their energies, scaled Jacobians and smallest determinants (the same values, so the
+  // same bits; on cthead h 2 these whole-mesh passes were a third of the untangler's time).
+  std::vector<double> hex_e, hdet;
+  std::vector<std::uint8_t> det_stale(mesh.hexes.size(), 1);  // hdet to recompute
   for (int it = 1; it <= options.max_iter; ++it) {
     for (std::size_t h = 0; h < sj.size(); ++h) {
-      bernstein[h] = sj[h] <= 0 || is_degenerate(sj[h]);
-      if (bernstein[h]) interior[h] = 1;
+      const std::uint8_t b = sj[h] <= 0 || is_degenerate(sj[h]);
+      if (b != bernstein[h] || (b && !interior[h])) det_stale[h] = 1;  // the frames it counts change
+      bernstein[h] = b;
+      if (b) interior[h] = 1;
     }
-    const double e_before = opt::total_energy(mesh, inv_len, params, energy_skip);
+    opt::hex_energies(mesh, inv_len, params, energy_skip, hex_e);  // ε changed: all of them
+    const double e_before = opt::energy_sum(hex_e);
     const std::vector<std::uint8_t> frozen = frozen_outside(mesh, inc, sj, options.margin, options.rings, skipped);
     for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2);
-    const double e_after = opt::total_energy(mesh, inv_len, params, energy_skip);
-    sj = certified_scaled_jacobians(mesh);
+    const std::vector<std::uint8_t> touched = touched_hexes(mesh, frozen);
+    opt::hex_energies(mesh, inv_len, params, energy_skip, hex_e, &touched);
+    const double e_after = opt::energy_sum(hex_e);
+    update_sj(mesh, touched, sj);
+    for (std::size_t h = 0; h < touched.size(); ++h) det_stale[h] |= touched[h];
     stats = stats_of(sj, skipped);
     iterations = it;
     if (options.progress) options.progress({"untangle", it, e_after / (9.0 * mesh.num_hexes()), stats.min, stats.inverted});
@@ -196,7 +227,8 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     // D < 0) dominate every vertex they share, crushing the valid neighbours for nothing, and
     // blow the energy up; they also leave the ε schedule. A stuck hex that becomes valid again
     // is released.
-    const std::vector<double> hdet = hex_min_det(mesh, inv_len, skipped, params);
+    hex_min_det(mesh, inv_len, skipped, params, hdet, &det_stale);
+    std::fill(det_stale.begin(), det_stale.end(), 0);
     double dmin = 1e300;
     for (Index h = 0; h < mesh.num_hexes(); ++h) {
       if (skipped && skip[h]) continue;
@@ -253,6 +285,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
         stats = after;
         best_inverted = std::min(best_inverted, after.inverted);
         sj = certified_scaled_jacobians(mesh);
+        std::fill(det_stale.begin(), det_stale.end(), 1);  // the LP moved vertices anywhere
         since_progress = 0;  // a new window from here
       }
     }

@@ -313,12 +313,39 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   for (Index h = 0; h < mesh.num_hexes(); ++h) update(h);
   const auto mesh_min = [&] { return sj.empty() ? 1.0 : *std::min_element(sj.begin(), sj.end()); };
   res.min_sj_before = res.min_sj_after = mesh_min();
-  std::vector<Index> order(mesh.hexes.size());
+  std::vector<Index> order;
   std::vector<Index> seen(mesh.points.size(), -1);
   const std::vector<Vec3> start = mesh.points;
-  const auto sort_worst_first = [&] {  // a fixed order: worst first, ties by id
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) { return rank[a] < rank[b]; });
+  // A fixed order: worst first by the ranks at the time of sorting, ties by id. The loops read
+  // it while moves change ranks, so how far they go is open; it is sorted lazily instead
+  // (on cthead h 2 a full sort of 585,000 hexes per pass took about a fifth of the passes'
+  // time): first the hexes below max(0.2, raise_below) and at least the `count` lowest, then
+  // more on demand (has()), in the same order as a full sort.
+  const double needed_below = std::max(options.raise_below, kQuestionableSJ);
+  std::vector<double> sorted_rank;  // the ranks `order` is sorted by
+  std::vector<Index> unsorted;      // the hexes not in `order` yet
+  const auto worse = [&](Index a, Index b) {
+    return sorted_rank[a] < sorted_rank[b] || (sorted_rank[a] == sorted_rank[b] && a < b);
+  };
+  const auto take = [&](std::size_t k) {  // the k worst of `unsorted`, appended in order
+    k = std::min(k, unsorted.size());
+    const auto mid = unsorted.begin() + static_cast<std::ptrdiff_t>(k);
+    if (mid != unsorted.end()) std::nth_element(unsorted.begin(), mid, unsorted.end(), worse);
+    std::sort(unsorted.begin(), mid, worse);
+    order.insert(order.end(), unsorted.begin(), mid);
+    unsorted.erase(unsorted.begin(), mid);
+  };
+  const auto has = [&](std::size_t i) {  // order[i] exists (sorted further if needed)
+    if (i >= order.size() && !unsorted.empty()) take(std::max<std::size_t>(i + 1 - order.size(), order.size()));
+    return i < order.size();
+  };
+  const auto sort_worst_first = [&] {
+    sorted_rank = rank;
+    order.clear();
+    unsorted.clear();
+    for (Index h = 0; h < mesh.num_hexes(); ++h) (rank[h] < needed_below ? order : unsorted).push_back(h);
+    std::sort(order.begin(), order.end(), worse);
+    has(std::max<std::size_t>(options.count, 1) - 1);  // standing() reads them
   };
   int pass = 0;
   // What a pass is judged by, read off `order` (sorted worst first): the lowest rank, the
@@ -333,7 +360,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     if (k == 0) return s;
     s.min = rank[order[0]];
     for (std::size_t i = 0; i < k; ++i) s.tail += rank[order[i]] / static_cast<double>(k);
-    for (std::size_t i = 0; i < order.size() && rank[order[i]] < kQuestionableSJ; ++i)
+    for (std::size_t i = 0; has(i) && rank[order[i]] < kQuestionableSJ; ++i)
       s.deficit += kQuestionableSJ - rank[order[i]];
     return s;
   };
@@ -371,7 +398,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       std::size_t moved = 0;
       const double min_now = mesh_min();
       for (std::size_t i = 0;
-           i < order.size() && ((i < options.count && rank[order[i]] < options.below) || rank[order[i]] < options.raise_below);
+           has(i) && ((i < options.count && rank[order[i]] < options.below) || rank[order[i]] < options.raise_below);
            ++i) {
         for (Index v : mesh.hexes[order[i]]) {
           if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
@@ -444,7 +471,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     if (too_many_poor(poor)) break;
     std::fill(clustered.begin(), clustered.end(), 0);
     std::size_t moved = 0;
-    for (std::size_t i = 0; i < order.size() && i < options.count && rank[order[i]] < kQuestionableSJ; ++i) {
+    for (std::size_t i = 0; i < options.count && has(i) && rank[order[i]] < kQuestionableSJ; ++i) {
       const Index h = order[i];
       if (clustered[h]) continue;
       const std::vector<Index> cluster = cluster_of(h, poor);
@@ -478,7 +505,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     if (options.search_trials == 0 || too_many_poor(member)) return;
     std::fill(clustered.begin(), clustered.end(), 0);
     std::size_t gains = 0;
-    for (std::size_t i = 0; i < order.size() && poor(order[i]); ++i) {
+    for (std::size_t i = 0; has(i) && poor(order[i]); ++i) {
       const Index h = order[i];
       if (clustered[h] || !member(h)) continue;
       const auto t0 = Clock::now();
