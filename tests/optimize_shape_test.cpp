@@ -14,6 +14,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <numeric>
+#include <random>
+#include <cmath>
+#include <limits>
 #include <set>
 
 using namespace isohex;
@@ -81,6 +84,56 @@ TEST(OptimizeShape, DerivativesMatchFiniteDifferences) {
   EXPECT_GT(std::abs(opt::vertex_energy(m, inc, il, v, m.points[v], b) -
                      opt::vertex_energy(m, inc, il, v, m.points[v], frames_only)),
             1e-6);
+}
+
+// The energies' x^(−1/3) against long double's cbrtl over the normal doubles: within 2 ulp
+// (the Newton steps square the error of a start from the bits; a wrong start constant or one
+// step fewer leaves errors far above that), and glibc's answer for what it does not take.
+TEST(OptimizeShape, InverseCubeRootIsAccurate) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> mantissa(1.0, 2.0);
+  std::uniform_int_distribution<int> exponent(-1021, 1023);
+  double worst = 0;
+  for (int i = 0; i < 2000000; ++i) {
+    const double x = std::ldexp(mantissa(rng), exponent(rng));
+    const long double exact = 1.0L / cbrtl(static_cast<long double>(x));
+    worst = std::max(worst, static_cast<double>(std::abs((opt::inverse_cbrt(x) - exact) / exact)));
+  }
+  for (double x : {1.0, 8.0, 0.125, 27.0, 1e-10, 1e300, std::numeric_limits<double>::min(),
+                   std::numeric_limits<double>::max()}) {
+    const long double exact = 1.0L / cbrtl(static_cast<long double>(x));
+    worst = std::max(worst, static_cast<double>(std::abs((opt::inverse_cbrt(x) - exact) / exact)));
+  }
+  EXPECT_LE(worst, 2 * std::numeric_limits<double>::epsilon());
+  EXPECT_EQ(opt::inverse_cbrt(0.0), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(opt::inverse_cbrt(-8.0), -0.5);
+  EXPECT_TRUE(std::isnan(opt::inverse_cbrt(std::nan(""))));
+  const double tiny = std::numeric_limits<double>::denorm_min() * 1000;  // subnormal: the fallback
+  EXPECT_EQ(opt::inverse_cbrt(tiny), 1 / std::cbrt(tiny));
+}
+
+// A vertex at its energy's minimum (the middle of a grid of cubes away from the origin) does
+// not move, and its line search evaluates nothing: its gradient is rounding noise, and the
+// search gives up at once instead of halving its step 30 times in search of a decrease of the
+// same noise. Moved off its place, it searches and moves back.
+TEST(OptimizeShape, ConvergedVertexStays) {
+  HexMesh m = box_mesh(3, 3, 3, Vec3(10.1, 20.2, 30.3), Vec3(10.4, 20.5, 30.6));
+  const Index v = 1 + 4 + 16;
+  const Incidence inc = vertex_hexes(m);
+  const std::vector<double> il = opt::inverse_edge_lengths(m);
+  for (const opt::EnergyParams& p : {opt::EnergyParams{}, opt::EnergyParams{true, 0.3, 0.5}}) {
+    const opt::Move mv = opt::newton_move(m, inc, il, v, p);
+    EXPECT_GT(mv.grad, 0);  // noise, not zero: the early return for a zero gradient is not what stops it
+    EXPECT_FALSE(mv.moved);
+    EXPECT_EQ(mv.trials, 0);
+    EXPECT_EQ(mv.x, m.points[v]);
+  }
+  const Vec3 home = m.points[v];
+  m.points[v] += Vec3(0.01, -0.02, 0.015);
+  const opt::Move back = opt::newton_move(m, inc, il, v, opt::EnergyParams{});
+  EXPECT_TRUE(back.moved);
+  EXPECT_GE(back.trials, 1);
+  EXPECT_LT((back.x - home).norm(), (m.points[v] - home).norm());
 }
 
 TEST(OptimizeShape, ColoringSeparatesVerticesOfEachHex) {

@@ -47,7 +47,12 @@ MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<do
   for (int i = 0; i < rows; ++i) B[i] = cols + i;
   c[n] = 1;  // reduced costs; the objective value itself is read off the solution
   constexpr double tol = 1e-12;
-  for (int pivots = 0; pivots < 50 * rows; ++pivots) {
+  // At most 8 pivots a row. Under Bland's rule a few LPs stall on degenerate vertices for
+  // thousands (cthead h 4: 39 of the joint moves' 722 LPs took 80 % of their pivots, up to
+  // 16,000 each, 15 s), and none of those gave a move that was kept (the same mesh with 4 or
+  // 8 a row as with 50); the bone's joint move (OptimizePatch.JointMovesGoOnWhereSingleMovesStop)
+  // needs 6.
+  for (int pivots = 0; pivots < 8 * rows; ++pivots) {
     // Bland's rule (smallest variable index enters and leaves) cannot cycle. (The largest
     // reduced cost took an eighth of its pivots on cthead's patches, but its optimum, as good
     // in the model, left the bone's joint moves (tests/data/bone_cluster.txt) without a gain.)

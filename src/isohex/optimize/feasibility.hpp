@@ -29,7 +29,7 @@ struct Affine {
 struct MaxMin {
   Vec3 d = Vec3::Zero();
   double s = 0;
-  bool ok = false;  ///< false only if the simplex failed (no constraints, or no pivot limit reached)
+  bool ok = false;  ///< false only if the simplex failed (no constraints, or its limit of 8 pivots a row reached)
 };
 
 /// Maximises the smallest f_i(d)/w_i over the cube |d_j| <= box (w_i > 0). A dense simplex
