@@ -205,20 +205,30 @@ std::vector<double> inverse_edge_lengths(const HexMesh& mesh) {
   return inv;
 }
 
-Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
-  // Σ_k (P_k − P_0) c_{t,k}ᵀ (Σ c_k = 0: relative to P0), entry by entry in k order, then
-  // scaled: the arithmetic of the matrix expression, without its temporaries on the stack.
-  double a[3][3] = {};
-  const auto& coef = kCoef[static_cast<std::size_t>(t)];
-  for (int k = 0; k < 8; ++k) {
-    const double d[3] = {p[k][0] - p[0][0], p[k][1] - p[0][1], p[k][2] - p[0][2]};
-    const Vec3& c = coef[static_cast<std::size_t>(k)];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) a[i][j] += d[i] * c[j];
-  }
+Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   Mat3 A;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;
+  if (t < 8) {
+    const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
+    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
+  } else if (t == kCentreFrame) {
+    A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
+    A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
+    A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
+  } else {
+    // Σ_k (P_k − P_0) c_{t,k}ᵀ (Σ c_k = 0: relative to P0), entry by entry in k order, then
+    // scaled: the arithmetic of the matrix expression `A += (P_k − P_0) c_kᵀ`, whose
+    // temporaries on the stack stalled every load (most of frame()'s samples on cthead).
+    double a[3][3] = {};
+    const auto& coef = kCoef[static_cast<std::size_t>(t)];
+    for (int k = 0; k < 8; ++k) {
+      const double d[3] = {p[k][0] - p[0][0], p[k][1] - p[0][1], p[k][2] - p[0][2]};
+      const Vec3& c = coef[static_cast<std::size_t>(k)];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) a[i][j] += d[i] * c[j];
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;
+  }
   return A;
 }
 
@@ -354,12 +364,22 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   // and the guard: the rounds' shape stage took cthead's bone (iso 1200, h 5) from 0.124 to
   // 0.093 and the worst pass won back less each round.
   const bool guarded = !params.untangle && params.rank_guard > -kInf;
+  // The shape stage's search gives up where no step can matter: a predicted decrease below
+  // 1e-12 of the vertex's energy, or a step shorter than 1e-6 of an edge. Converged vertices
+  // and blocked ones had gone through all 30 halvings: 4 % of cthead h 4's moves, half of the
+  // stage's line-search evaluations. Not in the untangler: a vertex next to a stuck hex has an
+  // energy dominated by that hex's frozen terms, and held to a decrease relative to it, such
+  // vertices stopped helping their other hexes (headsq iso 1000 h 2.5 left the untangler with
+  // a mean ratio objective of 2.4 instead of 1.4, and the shape stage ran 100 sweeps).
+  if (!params.untangle && !(-slope > 1e-12 * std::abs(e0))) return m;  // before the floors: they cost certificates
+  const double shortest = params.untangle ? 0.0 : 1e-6 * len;
   // The ratio bounds kept per hex (EnergyParams::hex_ratio) save a certificate's coefficients
   // per hex and move: a move's floors read them, its accepted step writes those it computed.
   std::vector<double>* cache = !params.untangle && !guarded && !params.skip ? params.hex_ratio : nullptr;
-  std::vector<double> ratio_floor, rank_floor, ratios;
-  ratio_floor.reserve(static_cast<std::size_t>(inc.count(v)));
-  if (cache) ratios.reserve(static_cast<std::size_t>(inc.count(v)));
+  // Per-thread buffers: a move runs to its end on its thread, and three vectors allocated per
+  // move were a malloc and a free each in the innermost loop of every sweep.
+  thread_local std::vector<double> ratio_floor, rank_floor, ratios;
+  ratio_floor.clear(), rank_floor.clear(), ratios.clear();
   if (!params.untangle)
     for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
       const Index h = inc.ids[i];
@@ -370,15 +390,6 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
       ratio_floor.push_back(c.ratio_bound >= kShapeRatioFloor ? kShapeRatioFloor : -kInf);
       if (guarded) rank_floor.push_back(std::min(hex_rank(c), params.rank_guard));
     }
-  // The shape stage's search gives up where no step can matter: a predicted decrease below
-  // 1e-12 of the vertex's energy, or a step shorter than 1e-6 of an edge. Converged vertices
-  // and blocked ones had gone through all 30 halvings, 4 % of cthead h 4's moves taking half
-  // of the stage's energy evaluations. Not in the untangler: a vertex next to a stuck hex has
-  // an energy dominated by that hex's frozen terms, and held to a decrease relative to it,
-  // such vertices stopped helping their other hexes (headsq iso 1000 h 2.5 left the untangler
-  // with a mean ratio objective of 2.4 instead of 1.4, and the shape stage ran 100 sweeps).
-  if (!params.untangle && !(-slope > 1e-12 * std::abs(e0))) return m;
-  const double shortest = params.untangle ? 0.0 : 1e-6 * len;
   double t = 1;
   for (int i = 0; i < 30 && t * dn >= shortest; ++i, t *= 0.5) {
     Vec3 x = m.x + t * d;

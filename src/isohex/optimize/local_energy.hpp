@@ -91,8 +91,9 @@ const std::array<int, 27>& lattice_frames();
 
 /// x^(−1/3) for x > 0, within 2 ulp for normal x: the exponent divided by 3 from the bits, then
 /// four Newton steps y ← y (4 − x y³)/3, each squaring the relative error, without a
-/// division. The energies' D^(−2/3), D^(−5/3) and D^(−8/3) are its powers: glibc's cbrt
-/// (with its frexp and ldexp calls) and three divisions per frame took a sixth of cthead's run.
+/// division. The energies' D^(−2/3), D^(−5/3) and D^(−8/3) are its powers: glibc's cbrt with
+/// its frexp, ldexp and scalbn calls took 14 % of cthead h 4's CPU (perf), and three divisions
+/// per frame followed it.
 inline double inverse_cbrt(double x) {
   std::uint64_t bits;
   std::memcpy(&bits, &x, sizeof bits);
@@ -109,26 +110,8 @@ inline double inverse_cbrt(double x) {
 /// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
 std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
 
-/// Frame t >= kFrames (inside the element) of corners p, scaled by inv_len: see frame().
-Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
-
-/// Frame t of corners p (already the hex's corners), scaled by inv_len. Inline: the energy's
-/// inner loop calls it for every frame, and an out-of-line call returned the matrix through
-/// memory that the next instruction read back (a tenth of vertex_energy()'s time).
-inline Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
-  Mat3 A;
-  if (t < 8) {
-    const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
-    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
-  } else if (t == kCentreFrame) {
-    A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
-    A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
-    A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
-  } else {
-    A = interior_frame(p, t, inv_len);
-  }
-  return A;
-}
+/// Frame t of corners p (already the hex's corners), scaled by inv_len.
+Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len);
 
 /// The coefficient c_{t,k} of corner k in frame t (zero when frame t does not use corner k).
 const Vec3& frame_coefficient(int t, int k);

@@ -190,7 +190,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   res.stop = "max_iter";
   // Per iteration only the hexes a sweep can change (touched_hexes()) are evaluated again after
   // it: their energies, scaled Jacobians and smallest determinants (the same values, so the
-  // same bits; on cthead h 2 these whole-mesh passes were a third of the untangler's time).
+  // same bits; cthead h 4's first untangler 18.3 -> 13.6 s with the same mesh).
   std::vector<double> hex_e, hdet;
   std::vector<std::uint8_t> det_stale(mesh.hexes.size(), 1);  // hdet to recompute
   for (int it = 1; it <= options.max_iter; ++it) {
