@@ -37,7 +37,7 @@ struct Args {
   double feature_angle = 30;
   FixedVertices fixed = FixedVertices::boundary;
   std::optional<int> max_iter;  ///< unset: each stage's own limit (untangle 200, shape 100)
-  double tol = ShapeOptions{}.tol, margin = 0.05;
+  double tol = ShapeOptions{}.tol, cull = ShapeOptions{}.cull, margin = 0.05;
   double surface_band = 0;  ///< --surface-band, in mean boundary edge lengths
   int patch_rounds = WorstOptions{}.patch_rounds;  ///< --patch-rounds
   int worst_passes = WorstOptions{}.passes;        ///< --worst-passes
@@ -133,6 +133,7 @@ void run(const Args& a) {
     o.shape_options.max_iter = *a.max_iter;
   }
   o.shape_options.tol = a.tol;
+  o.shape_options.cull = a.cull;
   if (a.shape_guard) o.shape_options.rank_guard = *a.shape_guard;
   o.worst_options.patch_rounds = a.patch_rounds;
   o.worst_options.passes = a.worst_passes;
@@ -148,7 +149,9 @@ void run(const Args& a) {
     for (const Quad& q : boundary_quads(mesh))
       for (int i = 0; i < 4; ++i, ++edges) sum += (mesh.points[q[(i + 1) % 4]] - mesh.points[q[i]]).norm();
     band = edges ? a.surface_band * sum / static_cast<double>(edges) : 0;
-    report["rounds"] = release_rounds(mesh, *surface, band, o);
+    std::size_t reattached = 0;
+    report["rounds"] = release_rounds(mesh, *surface, band, o, &reattached);
+    report["reattached"] = reattached;
   }
 
   const MetricSummary after = sj_summary(mesh);
@@ -232,6 +235,10 @@ void register_smooth(CLI::App& app) {
                   "Iteration limit of the untangler and the shape stage (default 200 and 100; the untangler "
                   "usually stops earlier, when it stalls)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--tol", a->tol, "Stop the shape stage below this relative improvement per sweep (default 1e-4)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--cull", a->cull,
+                  "Shape stage: a sweep moves only the vertices near one that moved more than this fraction of an "
+                  "edge in the sweep before (default 0.01; 0 moves every vertex every sweep)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--margin", a->margin, "Untangling target for the minimum scaled Jacobian (default 0.05)");
   cmd->add_flag("--no-worst", a->no_worst, "Skip the worst-element pass");

@@ -54,7 +54,10 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 /// the hexes up to 3 vertex rings around them, into a band of half-width `band` (world
 /// units) about their surface (BoundarySurface::loosen) and optimise again within 3 hex rings
 /// of those hexes. Returns each round's JSON facts (with "released": vertices released).
-nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& options);
+/// Ends by putting released vertices back on their surface where the hexes allow it
+/// (reattach_released()); how many, into `reattached` (may be null).
+nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& options,
+                              std::size_t* reattached = nullptr);
 
 /// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
 /// (`--boundary slide`): each boundary vertex on its own surface, the one `vertex_place` names

@@ -204,6 +204,7 @@ TEST(MeshCli, SurfaceBandReleasesKnifeEdgesWithinTheBand) {
   EXPECT_DOUBLE_EQ(b["band"].get<double>(), 0.3 * 3.2);  // the default: 0.3 cells
   const int loose = b["loose"].get<int>();
   EXPECT_GT(loose, 0);
+  EXPECT_GT(b["reattached"].get<int>(), 0);  // put back onto the isosurface after the rounds
   EXPECT_EQ(band["off_surface_vertices"], 0);  // those not released
   EXPECT_GT(band["released_vertices"].get<int>(), 0);
   EXPECT_LE(band["released_vertices"].get<int>(), loose);  // (released box-face vertices are the box's)
@@ -335,7 +336,7 @@ TEST(MeshCli, SmoothReleasesIntoTheBandToo) {
   ASSERT_EQ(run_cli("mesh " + q(dir / "b.nrrd") + " --iso 51 --no-smooth -o " + q(dir / "p.vtu"), &out), 0) << out;
   const std::string smooth = "smooth " + q(dir / "p.vtu") + " --untangle --boundary slide --volume " + q(dir / "b.nrrd") +
                              " --iso 51 ";
-  ASSERT_LE(run_cli(smooth + "-o " + q(dir / "s0.vtu") + " --json " + q(dir / "s0.json"), &out), 1) << out;
+  ASSERT_LE(run_cli(smooth + "--cull 0 -o " + q(dir / "s0.vtu") + " --json " + q(dir / "s0.json"), &out), 1) << out;
   ASSERT_EQ(run_cli(smooth + "--surface-band 0.3 -o " + q(dir / "s1.vtu") + " --json " + q(dir / "s1.json"), &out), 0) << out;
   const auto s0 = nlohmann::json::parse(io::read_file(dir / "s0.json"));
   const auto s1 = nlohmann::json::parse(io::read_file(dir / "s1.json"));
@@ -344,6 +345,7 @@ TEST(MeshCli, SmoothReleasesIntoTheBandToo) {
   EXPECT_LT(s1["after"]["below_0.2"].get<int>(), s0["after"]["below_0.2"].get<int>() / 4);
   EXPECT_EQ(s1["after"]["inverted"], 0);
   EXPECT_GT(s1["boundary"]["loose"].get<int>(), 0);
+  EXPECT_GT(s1["reattached"].get<int>(), 0);  // some released vertices went back onto the isosurface
   EXPECT_LE(s1["boundary"]["max_loose_distance"].get<double>(), s1["boundary"]["band"].get<double>() * (1 + 1e-6));
   EXPECT_GT(s1["boundary"]["band"].get<double>(), 0.2);  // 0.3 of a mean edge of about a voxel
   EXPECT_NE(run_cli("smooth " + q(dir / "p.vtu") + " --surface-band 0.3 -o " + q(dir / "x.vtu"), &out), 0);

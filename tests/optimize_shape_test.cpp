@@ -186,6 +186,34 @@ TEST(OptimizeShape, JitteredGridsStayValidAndImprove) {
   }
 }
 
+// Culling: on a grid jittered at one end only, the far vertices never move more than the
+// cull fraction, so sweeps after the first hold them (ShapeResult::culled) and the objective
+// ends where sweeping every vertex ends it; cull 0 holds none.
+TEST(OptimizeShape, CullingHoldsVerticesThatStopped) {
+  HexMesh start = box_mesh(10, 10, 10);
+  HexMesh shaken = start;
+  jitter(shaken, 0.25 / 10, 4);
+  for (std::size_t v = 0; v < start.points.size(); ++v)
+    if (start.points[v].x() < 0.25) start.points[v] = shaken.points[v];
+  const std::vector<std::uint8_t> fixed = boundary_vertex_mask(start);
+  std::size_t free = 0;
+  for (std::uint8_t f : fixed) free += !f;
+  HexMesh all = start, culled = start;
+  ShapeOptions o;
+  o.cull = 0;
+  const ShapeResult ra = optimize_shape(all, fixed, o);
+  EXPECT_EQ(ra.culled, 0u);
+  o.cull = 1e-2;
+  const ShapeResult rc = optimize_shape(culled, fixed, o);
+  EXPECT_GT(rc.culled, free / 2);
+  EXPECT_LT(rc.objective_after, rc.objective_before);
+  EXPECT_NEAR(rc.objective_after, ra.objective_after, 1e-3 * (ra.objective_before - ra.objective_after));
+  std::size_t far_moved = 0;
+  for (std::size_t v = 0; v < start.points.size(); ++v)
+    far_moved += start.points[v].x() > 0.75 && culled.points[v] != start.points[v];
+  EXPECT_EQ(far_moved, 0u);
+}
+
 TEST(OptimizeShape, InvalidHexesAreHeldAndOthersStayValid) {
   HexMesh m = jittered_box(4, 0.2, 5);
   const Index v = 1 + 5 + 25;  // interior vertex; push it far to invert its hexes

@@ -4,6 +4,7 @@
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/generate.hpp"
 #include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
@@ -535,6 +536,52 @@ TEST(OptimizeSlide, LooseVerticesStayWithinTheirBand) {
   EXPECT_EQ(two.inverted, 0u);
   EXPECT_GE(two.min_sj, slide.min_sj - 1e-9);
   EXPECT_EQ(one.mesh.points, two.mesh.points);
+}
+
+// reattach_released(): loose vertices pushed off the sphere (within the band) go back onto it
+// where no hex around them ends below the lower of its rank before and max(floor, the mesh's
+// lowest rank); those are sliding again, the others stay loose where they were; with a floor
+// of 1 no hex's rank falls at all.
+TEST(OptimizeSlide, ReleasedVerticesGoBackWhereTheHexesAllow) {
+  const Volume volume = distance_volume(41);
+  const IsoField field(volume, 1.0, Inside::below);
+  const HexMesh in = distorted_iso_ball(field);
+  const auto ranks = [](const HexMesh& m) {
+    std::vector<double> r;
+    for (Index h = 0; h < m.num_hexes(); ++h) r.push_back(opt::hex_rank(certified_quality(m.corners(h))));
+    return r;
+  };
+  for (const double floor : {0.3, 1.0}) {
+    HexMesh m = in;
+    BoundarySurface surface(m, field);
+    std::vector<Index> loose;
+    for (Index v = 0; v < m.num_vertices(); ++v)
+      if (surface.role(v) == BoundarySurface::Role::slides && v % 3 == 0) loose.push_back(v);
+    ASSERT_EQ(surface.loosen(m, loose, 0.05), loose.size());
+    // Outwards by 0.03 (within the band), a few far enough out to flatten their hexes.
+    for (Index v : loose) m.points[v] *= 1 + (v % 2 ? 0.03 : 0.01) / m.points[v].norm();
+    const HexMesh before = m;
+    const std::vector<double> r0 = ranks(m);
+    const double lowest = *std::min_element(r0.begin(), r0.end());
+    ReattachOptions o;
+    o.floor = floor;
+    const ReattachResult res = reattach_released(m, surface, o);
+    EXPECT_EQ(res.loose_before, loose.size());
+    EXPECT_GT(res.reattached, floor < 1 ? loose.size() / 2 : 0) << floor;  // 56 and 19 of 74
+    EXPECT_EQ(surface.num_loose(), loose.size() - res.reattached);
+    for (Index v : loose) {
+      if (surface.role(v) == BoundarySurface::Role::slides) {
+        EXPECT_LE(std::abs(field.level(m.points[v])), 1e-6 * field.value_range()) << v;
+        EXPECT_NE(m.points[v], before.points[v]);
+      } else {
+        EXPECT_EQ(surface.role(v), BoundarySurface::Role::loose);
+        EXPECT_EQ(m.points[v], before.points[v]);
+      }
+    }
+    const std::vector<double> r1 = ranks(m);
+    for (std::size_t h = 0; h < r1.size(); ++h)
+      EXPECT_GE(r1[h], std::min(r0[h], std::max(floor, lowest))) << h << " floor " << floor;
+  }
 }
 
 // band_clamp: a point far off is brought back to the band's distance from its foot point,

@@ -463,10 +463,9 @@ double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc
   return max_grad;
 }
 
-SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip) {
+SJStats sj_stats_of(const std::vector<double>& sj, const std::vector<std::uint8_t>* skip) {
   SJStats s;
   s.min = 1.0;  // the scaled Jacobian's largest value: also the answer for no hexes
-  const std::vector<double> sj = certified_scaled_jacobians(mesh);
   for (std::size_t h = 0; h < sj.size(); ++h) {
     if (skip && (*skip)[h]) continue;
     double v = sj[h];
@@ -475,6 +474,10 @@ SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip) {
     s.inverted += v <= 0;
   }
   return s;
+}
+
+SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip) {
+  return sj_stats_of(certified_scaled_jacobians(mesh), skip);
 }
 
 }  // namespace isohex::opt

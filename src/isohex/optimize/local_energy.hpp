@@ -200,5 +200,7 @@ struct SJStats {
 };
 /// With `skip`, over the other hexes only.
 SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip = nullptr);
+/// The same from certified scaled Jacobians already computed (one per hex).
+SJStats sj_stats_of(const std::vector<double>& sj, const std::vector<std::uint8_t>* skip = nullptr);
 
 }  // namespace isohex::opt

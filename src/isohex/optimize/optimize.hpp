@@ -207,6 +207,10 @@ struct ShapeOptions {
   double tol = 1e-4;         ///< stop when a sweep lowers the objective by less than tol (relative) ...
   double min_sj_gain = 1e-3; ///< ... and raises the smallest certified scaled Jacobian by less than this
   double grad_tol = 1e-8;    ///< ... or when the largest vertex gradient (× edge length) is below this
+  /// Culling: a sweep moves only the vertices of the hexes around a vertex that moved more
+  /// than this fraction of its mean edge length in the sweep before (0: every vertex, every
+  /// sweep). cthead h 3: sweeps 26.3 -> 9.8 s, mean scaled Jacobian 0.9000 -> 0.8997.
+  double cull = 1e-2;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
   /// No step takes a hex's rank, the lower of its certified scaled Jacobian and twice its
   /// jacobian ratio bound, below the lower of its rank before the step and this (-inf: off).
@@ -221,6 +225,7 @@ struct ShapeResult {
   int iterations = 0;
   double objective_before = 0, objective_after = 0;  ///< mean corner inverse mean ratio (1 = cubes)
   std::size_t frozen_hexes = 0;  ///< invalid hexes whose vertices were held (the barrier needs valid hexes)
+  std::size_t culled = 0;        ///< free vertices held at the end by ShapeOptions::cull
   std::vector<double> history;   ///< objective after each sweep
 };
 
@@ -339,5 +344,25 @@ struct OptimizeResult {
   double untangle_seconds = 0, shape_seconds = 0, worst_seconds = 0;
 };
 OptimizeResult optimize_mesh(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options = {});
+
+/// Options of reattach_released().
+struct ReattachOptions {
+  /// A vertex goes back onto its surface only if no hex around it ends with a rank (the lower
+  /// of its certified scaled Jacobian and twice its jacobian ratio bound) below the lower of
+  /// its rank now and max(floor, the mesh's lowest rank): the minimum and the count below 0.2
+  /// cannot get worse.
+  double floor = 0.3;
+  int rounds = 3;  ///< passes over the loose vertices (a vertex put back frees its neighbours)
+};
+/// What reattach_released() did.
+struct ReattachResult {
+  std::size_t loose_before = 0;  ///< loose vertices before
+  std::size_t reattached = 0;    ///< of them, back on their surface and sliding again
+};
+/// Puts the vertices that BoundarySurface::loosen() released back onto their surface
+/// (BoundarySurface::snap()) where the hexes around them allow it (ReattachOptions::floor),
+/// and makes them slide again: released for the optimiser's sake, they need not stay off the
+/// surface once it is done. Sequential in vertex order: the same mesh for any thread count.
+ReattachResult reattach_released(HexMesh& mesh, BoundarySurface& surface, const ReattachOptions& options = {});
 
 }  // namespace isohex

@@ -47,9 +47,17 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   }
   const Incidence inc = vertex_hexes(mesh);
   const VertexColoring coloring = color_vertices(mesh, fixed);
-  double e = mean_objective(mesh, inv_len, bad);
+  // The objective and the scaled Jacobians per hex, evaluated again after a sweep only where a
+  // vertex moved (the same values, summed in hex order: the same bits as whole-mesh passes).
+  std::size_t terms = 0;
+  for (std::uint8_t b : bad) terms += b ? 0 : 8;
+  std::vector<double> hex_e;
+  opt::hex_energies(mesh, inv_len, opt::EnergyParams{}, bad, hex_e);
+  const auto objective = [&] { return terms == 0 ? 1.0 : opt::energy_sum(hex_e) / static_cast<double>(terms); };
+  std::vector<double> sj = certified_scaled_jacobians(mesh);
+  double e = objective();
   res.objective_before = res.objective_after = e;
-  double min_sj = opt::sj_stats(mesh).min;
+  double min_sj = opt::sj_stats_of(sj).min;
   // Each hex's ratio bound, kept through the sweeps (EnergyParams::hex_ratio); a rank guard
   // reads the scaled Jacobian too, so its moves compute both and keep none.
   const bool keep_ratios = !(options.rank_guard > -std::numeric_limits<double>::infinity());
@@ -57,17 +65,49 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ratio.size()), [&](const auto& r) {
     for (std::size_t h = r.begin(); h != r.end(); ++h) ratio[h] = jacobian_ratio_bound(mesh.corners(static_cast<Index>(h)));
   });
+  // Culling: a sweep moves only the vertices near one that moved more than `cull` of its edge
+  // length in the sweep before (the rest are held, as in `frozen`).
+  std::vector<double> scale(mesh.points.size(), 0.0);
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) scale[v] += 1 / inv_len[inc.ids[i]];
+    if (inc.count(v) > 0) scale[v] /= static_cast<double>(inc.count(v));
+  }
+  const double cull = options.cull;
+  std::vector<std::uint8_t> held = frozen, changed(mesh.hexes.size(), 0);
+  std::vector<Vec3> before;
   for (int it = 1; it <= options.max_iter; ++it) {
     opt::EnergyParams params;
     params.surface = options.surface;
     params.rank_guard = options.rank_guard;
     params.hex_ratio = keep_ratios ? &ratio : nullptr;
-    const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 1);
-    const double e_new = mean_objective(mesh, inv_len, bad);
+    before = mesh.points;
+    const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, held, 1);
+    std::fill(changed.begin(), changed.end(), 0);
+    std::vector<std::uint8_t> active(mesh.points.size(), 0);
+    for (Index v = 0; v < mesh.num_vertices(); ++v) {
+      if (mesh.points[v] == before[v]) continue;
+      const bool far = (mesh.points[v] - before[v]).norm() > cull * scale[v];
+      for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+        changed[inc.ids[i]] = 1;
+        if (far)
+          for (Index w : mesh.hexes[inc.ids[i]]) active[w] = 1;
+      }
+    }
+    res.culled = 0;
+    for (Index v = 0; v < mesh.num_vertices() && cull > 0; ++v) {
+      held[v] = frozen[v] || !active[v];
+      res.culled += !frozen[v] && !active[v];
+    }
+    opt::hex_energies(mesh, inv_len, opt::EnergyParams{}, bad, hex_e, &changed);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sj.size(), 1024), [&](const auto& r) {
+      for (std::size_t h = r.begin(); h != r.end(); ++h)
+        if (changed[h]) sj[h] = certified_scaled_jacobian(mesh.corners(static_cast<Index>(h)));
+    });
+    const double e_new = objective();
     res.iterations = it;
     res.history.push_back(e_new);
     res.objective_after = e_new;
-    const opt::SJStats s = opt::sj_stats(mesh);
+    const opt::SJStats s = opt::sj_stats_of(sj);
     if (options.progress) options.progress({"shape", it, e_new, s.min, s.inverted});
     const double rel = (e - e_new) / e;
     const double sj_gain = s.min - min_sj;

@@ -143,6 +143,8 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
         if (k == surfaces_.size()) continue;
         target_[v] = static_cast<std::int8_t>(k);
       }
+      unpinned_.resize(role_.size(), 0);
+      unpinned_[v] = 1;
       --pinned_;
     } else if (role_[v] == static_cast<std::uint8_t>(Role::slides)) {
       --sliding_;
@@ -155,6 +157,26 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
   loose_ += n;
   band_ = band;
   return n;
+}
+
+bool BoundarySurface::snap(Index v, Vec3& x, double len) const {
+  if (surfaces_.empty()) {
+    x = project(x);
+    return true;
+  }
+  if (on_face(v) >= 0) return reproject(v, x, Vec3::Zero(), len);
+  Vec3 foot;
+  if (!foot_point(v, x, kFootReach * band_, foot)) return false;
+  x = foot;
+  return true;
+}
+
+bool BoundarySurface::reattach(Index v) {
+  if (role(v) != Role::loose || (!unpinned_.empty() && unpinned_[v])) return false;
+  role_[v] = static_cast<std::uint8_t>(Role::slides);
+  --loose_;
+  ++sliding_;
+  return true;
 }
 
 bool BoundarySurface::foot_point(Index v, const Vec3& x, double max_reach, Vec3& foot) const {

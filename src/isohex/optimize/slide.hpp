@@ -79,6 +79,14 @@ class BoundarySurface {
   /// input's triangles (feature vertices), or about the isosurface they lie on (a rim, where it
   /// meets the domain box).
   std::size_t loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band);
+  /// Where loose vertex v at x would sit on its target (`len`: the local edge length): the
+  /// nearest triangle point, a rim vertex's point on its curve, else its foot point on its
+  /// level set. False where there is none.
+  bool snap(Index v, Vec3& x, double len) const;
+  /// Makes loose vertex v, which the caller has put on its target (snap()), slide again. Only
+  /// for vertices loosen() released from sliding (false, and nothing changes, for the others:
+  /// a pinned vertex's place is not any point of one surface).
+  bool reattach(Index v);
   /// The box loose vertices must stay in (the domain: a band must not carry them out of it).
   void set_domain(const Aabb& box) { domain_ = box; has_domain_ = true; }
   /// Puts x, a step of loose vertex v (local edge length `len`), back within the band: into the
@@ -132,6 +140,7 @@ class BoundarySurface {
   std::vector<contour::LevelSet> surfaces_;
   std::vector<std::int8_t> target_;  // per vertex: index into surfaces_, −1 unless sliding on one
   std::vector<std::int8_t> face_;    // per vertex: the box face a rim vertex keeps to, or −1
+  std::vector<std::uint8_t> unpinned_;  // per vertex (or empty): loosen() released it from pinned
   std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
   double band_ = 0;
   Aabb domain_{Vec3::Zero(), Vec3::Zero()};

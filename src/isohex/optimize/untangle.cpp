@@ -57,19 +57,6 @@ void update_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::
   });
 }
 
-// opt::sj_stats from scaled Jacobians already computed.
-opt::SJStats stats_of(const std::vector<double>& sj, const std::vector<std::uint8_t>* skip) {
-  opt::SJStats s;
-  s.min = 1.0;
-  for (std::size_t h = 0; h < sj.size(); ++h) {
-    if (skip && (*skip)[h]) continue;
-    const double v = is_degenerate(sj[h]) ? -1 : sj[h];
-    s.min = std::min(s.min, v);
-    s.inverted += v <= 0;
-  }
-  return s;
-}
-
 double chi(double D, double eps) {
   const double s = std::sqrt(eps * eps + D * D);
   return D >= 0 ? 0.5 * (D + s) : eps * eps / (2 * (s - D));
@@ -150,7 +137,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   // "Valid" means certified valid inside (certified_scaled_jacobians(): 0 for a hex whose nine
   // samples are positive but that folds inside), so the untangler works on such hexes too.
   std::vector<double> sj = certified_scaled_jacobians(mesh);
-  opt::SJStats stats = stats_of(sj, skipped);
+  opt::SJStats stats = opt::sj_stats_of(sj, skipped);
   if (stats.min >= options.margin) {
     res.reached_margin = true;
     res.stop = "margin";
@@ -209,7 +196,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     const double e_after = opt::energy_sum(hex_e);
     update_sj(mesh, touched, sj);
     for (std::size_t h = 0; h < touched.size(); ++h) det_stale[h] |= touched[h];
-    stats = stats_of(sj, skipped);
+    stats = opt::sj_stats_of(sj, skipped);
     iterations = it;
     if (options.progress) options.progress({"untangle", it, e_after / (9.0 * mesh.num_hexes()), stats.min, stats.inverted});
     if (stats.inverted < best.inverted || (stats.inverted == best.inverted && stats.min > best.min)) {
