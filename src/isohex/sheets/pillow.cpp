@@ -91,7 +91,7 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
                         "no boundary quad)"
                       : "pillow: the shrink set has no interface: it contains every hex of its part of the mesh "
                         "(pillow the boundary instead)");
-    split = detail::split_interface(mesh, in, nb, iq, options);
+    split = detail::split_interface(mesh, in, nb, iq, options, hex_inc);
     if (split.flip_candidates.empty() || round == kMaxFlipRounds) break;
     // One flip per neighbourhood per round: a flip changes the interface around all of its
     // hex's vertices, which often settles the neighbouring stuck vertices too.

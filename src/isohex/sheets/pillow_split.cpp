@@ -47,13 +47,21 @@ constexpr double kSeen = 1e-9;  // a direction "sees" a corner if its cosine exc
 class Splitter {
  public:
   Splitter(const HexMesh& mesh, const std::vector<std::uint8_t>& in, const std::vector<std::array<Index, 6>>& nb,
-           const std::vector<InterfaceQuad>& iq, const PillowOptions& opt)
-      : m_(mesh), in_(in), nb_(nb), iq_(iq), opt_(opt), hex_inc_(vertex_hexes(mesh)) {
+           const std::vector<InterfaceQuad>& iq, const PillowOptions& opt, const Incidence& hex_inc)
+      : m_(mesh), in_(in), nb_(nb), iq_(iq), opt_(opt), hex_inc_(hex_inc) {
     std::vector<Quad> quads;
     quads.reserve(iq.size());
     for (const auto& q : iq) quads.push_back(q.v);
     iq_inc_ = vertex_cells(quads, mesh.num_vertices());
-    if (opt.include_boundary) boundary_ = boundary_vertex_mask(mesh);
+    // The boundary vertices from the faces with no hex across (boundary_vertex_mask() would
+    // sort every face again: on cthead h 2 that was the pipeline's memory peak).
+    if (opt.include_boundary) {
+      boundary_.assign(mesh.points.size(), 0);
+      for (std::size_t h = 0; h < nb.size(); ++h)
+        for (int f = 0; f < 6; ++f)
+          if (nb[h][static_cast<std::size_t>(f)] < 0)
+            for (int k = 0; k < 4; ++k) boundary_[mesh.hexes[h][kHexFaces[f][k]]] = 1;
+    }
     find_pinched_edges();
   }
 
@@ -506,7 +514,7 @@ class Splitter {
   const std::vector<std::array<Index, 6>>& nb_;
   const std::vector<InterfaceQuad>& iq_;
   const PillowOptions& opt_;
-  const Incidence hex_inc_;
+  const Incidence& hex_inc_;
   Incidence iq_inc_;
   std::vector<std::uint8_t> boundary_;
   std::vector<PinchedEdge> edges_;
@@ -518,8 +526,8 @@ class Splitter {
 
 InterfaceSplit split_interface(const HexMesh& mesh, const std::vector<std::uint8_t>& in,
                                const std::vector<std::array<Index, 6>>& nb, const std::vector<InterfaceQuad>& iq,
-                               const PillowOptions& options) {
-  return Splitter(mesh, in, nb, iq, options).run();
+                               const PillowOptions& options, const Incidence& hex_inc) {
+  return Splitter(mesh, in, nb, iq, options, hex_inc).run();
 }
 
 }  // namespace isohex::detail

@@ -68,9 +68,10 @@ struct InterfaceSplit {
   std::vector<std::array<Index, 2>> unpaired_edges;
 };
 
-/// Splits the interface. `nb[h][f]` is the hex across face f of h (-1 on the boundary).
+/// Splits the interface. `nb[h][f]` is the hex across face f of h (-1 on the boundary);
+/// `hex_inc` is vertex_hexes(mesh).
 InterfaceSplit split_interface(const HexMesh& mesh, const std::vector<std::uint8_t>& in,
                                const std::vector<std::array<Index, 6>>& nb, const std::vector<InterfaceQuad>& iq,
-                               const PillowOptions& options);
+                               const PillowOptions& options, const Incidence& hex_inc);
 
 }  // namespace isohex::detail
