@@ -41,6 +41,17 @@ std::vector<FaceKey> sorted_face_keys(const HexMesh& mesh) {
   return keys;
 }
 
+// Calls f(i, j) for each run keys[i..j) of one face (sorted keys).
+template <class F>
+void for_each_face(const std::vector<FaceKey>& keys, F&& f) {
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i + 1;
+    while (j < keys.size() && keys[j].key == keys[i].key) ++j;
+    f(i, j);
+    i = j;
+  }
+}
+
 }  // namespace
 
 std::vector<QuadFace> build_quads(const HexMesh& mesh) {
@@ -48,12 +59,10 @@ std::vector<QuadFace> build_quads(const HexMesh& mesh) {
   // Exactly as many as there are: a guess that falls short makes the vector grow to twice
   // its size with the old one still held (cthead h 2: 140 MB at validate()'s peak instead of 47).
   std::size_t unique = 0;
-  for (std::size_t i = 0; i < keys.size(); ++i) unique += i == 0 || keys[i].key != keys[i - 1].key;
+  for_each_face(keys, [&](std::size_t, std::size_t) { ++unique; });
   std::vector<QuadFace> quads;
   quads.reserve(unique);
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i + 1;
-    while (j < keys.size() && keys[j].key == keys[i].key) ++j;
+  for_each_face(keys, [&](std::size_t i, std::size_t j) {
     QuadFace q;
     q.vertices = face_vertices(mesh.hexes[keys[i].hex()], keys[i].face());
     q.hex[0] = keys[i].hex();
@@ -62,8 +71,7 @@ std::vector<QuadFace> build_quads(const HexMesh& mesh) {
     q.local[1] = static_cast<std::int8_t>(j - i > 1 ? keys[i + 1].face() : -1);
     q.extra_hexes = static_cast<Index>(j - i > 2 ? j - i - 2 : 0);
     quads.push_back(q);
-    i = j;
-  }
+  });
   return quads;
 }
 
@@ -78,12 +86,9 @@ std::vector<Quad> boundary_quads(const std::vector<QuadFace>& quads) {
 std::vector<Quad> boundary_quads(const HexMesh& mesh) {
   const std::vector<FaceKey> keys = sorted_face_keys(mesh);
   std::vector<Quad> out;
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i + 1;
-    while (j < keys.size() && keys[j].key == keys[i].key) ++j;
+  for_each_face(keys, [&](std::size_t i, std::size_t j) {
     if (j - i == 1) out.push_back(face_vertices(mesh.hexes[keys[i].hex()], keys[i].face()));
-    i = j;
-  }
+  });
   return out;
 }
 

@@ -23,11 +23,13 @@ MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<do
   const auto A = [&](int i, int j) { return a[static_cast<std::size_t>(i) * n + j]; };
   // Unknowns y = (u, σ) >= 0 with d_j = box_j (u_j − 1), u_j <= 2 (the box), and s = σ − S, S
   // chosen so that y = 0 is feasible: f_i(d) >= s·w_i  ⇔  −Σ box_j a_ij u_j + w_i σ <= b_i − Σ box_j a_ij + S w_i.
-  std::vector<double> shift(m, 0.0);
-  double S = 0;
+  // reach[i]: how far f_i can move over the box; U: an upper bound of s (see below).
+  std::vector<double> shift(m, 0.0), reach(m, 0.0);
+  double S = 0, U = std::numeric_limits<double>::infinity();
   for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < n; ++j) shift[i] += box[j] * A(i, j);
+    for (int j = 0; j < n; ++j) shift[i] += box[j] * A(i, j), reach[i] += box[j] * std::abs(A(i, j));
     S = std::max(S, (shift[i] - b[i]) / w[i]);
+    U = std::min(U, (b[i] + reach[i]) / w[i]);
   }
   S += 1;
   // Rows that bind nowhere in the box are left out: f_i >= s·w_i holds wherever s is feasible
@@ -36,12 +38,6 @@ MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<do
   // the basis and Bland's rule (indices kept in order) takes the same pivots on the rest, with
   // the same arithmetic: the same bits, on a third to a half of the rows (the worst pass's
   // ratio terms far above its minimum).
-  std::vector<double> reach(m, 0.0);
-  double U = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < n; ++j) reach[i] += box[j] * std::abs(A(i, j));
-    U = std::min(U, (b[i] + reach[i]) / w[i]);
-  }
   std::vector<int> kept;
   kept.reserve(m);
   for (int i = 0; i < m; ++i)

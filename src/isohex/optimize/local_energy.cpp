@@ -259,9 +259,7 @@ bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     if (skip && (*skip)[h]) continue;
-    std::array<Vec3, 8> p = mesh.corners(h);
-    for (int k = 0; k < 8; ++k)
-      if (mesh.hexes[h][k] == v) p[k] = x;
+    const std::array<Vec3, 8> p = corners_with(mesh, h, v, x);
     const auto at = static_cast<std::size_t>(i - inc.offsets[v]);
     // Only the certificate: a finite shape energy has checked the frames v changes already,
     // and the others are those of a hex that was feasible.
@@ -327,9 +325,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   Mat3 H;
   const double e0 = vertex_energy(mesh, inc, inv_len, v, m.x, params, &g, &H);
   if (!std::isfinite(e0) || inc.count(v) == 0) return m;
-  double len = 0;
-  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) len += 1 / inv_len[inc.ids[i]];
-  len /= static_cast<double>(inc.count(v));
+  const double len = vertex_length(inc, inv_len, v);
   m.grad = g.norm() * len;
   if (!(m.grad > 0)) return m;
   // Newton direction on the Hessian with its eigenvalues clamped positive (the regularised
@@ -478,6 +474,13 @@ SJStats sj_stats_of(const std::vector<double>& sj, const std::vector<std::uint8_
 
 SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip) {
   return sj_stats_of(certified_scaled_jacobians(mesh), skip);
+}
+
+void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::vector<double>& sj) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 1024), [&](const auto& r) {
+    for (std::size_t h = r.begin(); h != r.end(); ++h)
+      if (only[h]) sj[h] = certified_scaled_jacobian(mesh.corners(static_cast<Index>(h)));
+  });
 }
 
 }  // namespace isohex::opt

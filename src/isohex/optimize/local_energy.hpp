@@ -202,5 +202,22 @@ struct SJStats {
 SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip = nullptr);
 /// The same from certified scaled Jacobians already computed (one per hex).
 SJStats sj_stats_of(const std::vector<double>& sj, const std::vector<std::uint8_t>* skip = nullptr);
+/// certified_scaled_jacobian() of the hexes flagged in `only`, into sj (parallel).
+void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::vector<double>& sj);
+
+/// The corners of hex h with its vertex v placed at x.
+inline std::array<Vec3, 8> corners_with(const HexMesh& mesh, Index h, Index v, const Vec3& x) {
+  std::array<Vec3, 8> p = mesh.corners(h);
+  for (int k = 0; k < 8; ++k)
+    if (mesh.hexes[h][k] == v) p[k] = x;
+  return p;
+}
+
+/// The length scale of vertex v: the mean of its hexes' 1/inv_len (0 for an unused vertex).
+inline double vertex_length(const Incidence& inc, const std::vector<double>& inv_len, Index v) {
+  double len = 0;
+  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) len += 1 / inv_len[inc.ids[i]];
+  return inc.count(v) > 0 ? len / static_cast<double>(inc.count(v)) : 0.0;
+}
 
 }  // namespace isohex::opt

@@ -33,10 +33,7 @@ ReattachResult reattach_released(HexMesh& mesh, BoundarySurface& surface, const 
       bool ok = true;
       for (Index i = inc.offsets[v]; ok && i < inc.offsets[v + 1]; ++i) {
         const Index h = inc.ids[i];
-        auto p = mesh.corners(h);
-        for (int k = 0; k < 8; ++k)
-          if (mesh.hexes[h][k] == v) p[k] = x;
-        ranks.push_back(opt::hex_rank(certified_quality(p)));
+        ranks.push_back(opt::hex_rank(certified_quality(opt::corners_with(mesh, h, v, x))));
         ok = ranks.back() >= std::min(rank[h], floor);
       }
       if (!ok || !surface.reattach(v)) continue;

@@ -49,14 +49,6 @@ std::vector<std::uint8_t> touched_hexes(const HexMesh& mesh, const std::vector<s
   return t;
 }
 
-// certified_scaled_jacobian() of the hexes flagged in `only`, into sj.
-void update_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::vector<double>& sj) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.hexes.size(), 1024), [&](const auto& r) {
-    for (std::size_t h = r.begin(); h != r.end(); ++h)
-      if (only[h]) sj[h] = certified_scaled_jacobian(mesh.corners(static_cast<Index>(h)));
-  });
-}
-
 double chi(double D, double eps) {
   const double s = std::sqrt(eps * eps + D * D);
   return D >= 0 ? 0.5 * (D + s) : eps * eps / (2 * (s - D));
@@ -194,7 +186,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     const std::vector<std::uint8_t> touched = touched_hexes(mesh, frozen);
     opt::hex_energies(mesh, inv_len, params, energy_skip, hex_e, &touched);
     const double e_after = opt::energy_sum(hex_e);
-    update_sj(mesh, touched, sj);
+    opt::update_certified_sj(mesh, touched, sj);
     for (std::size_t h = 0; h < touched.size(); ++h) det_stale[h] |= touched[h];
     stats = opt::sj_stats_of(sj, skipped);
     iterations = it;

@@ -82,9 +82,7 @@ double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
   if (edges) *edges = 1.0;
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
-    auto p = mesh.corners(h);
-    for (int k = 0; k < 8; ++k)
-      if (mesh.hexes[h][k] == v) p[k] = x;
+    const auto p = opt::corners_with(mesh, h, v, x);
     double q;
     if (ratio) {  // both from one evaluation of the hex's Bernstein coefficients
       const CertifiedQuality c = certified_quality(p);
