@@ -133,7 +133,7 @@ void run(const Args& a) {
     o.shape_options.max_iter = *a.max_iter;
   }
   o.shape_options.tol = a.tol;
-  o.shape_options.cull = a.cull;
+  o.shape_options.cull = o.untangle_options.cull = a.cull;
   if (a.shape_guard) o.shape_options.rank_guard = *a.shape_guard;
   o.worst_options.patch_rounds = a.patch_rounds;
   o.worst_options.passes = a.worst_passes;
@@ -237,8 +237,9 @@ void register_smooth(CLI::App& app) {
   cmd->add_option("--tol", a->tol, "Stop the shape stage below this relative improvement per sweep (default 1e-4)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--cull", a->cull,
-                  "Shape stage: a sweep moves only the vertices near one that moved more than this fraction of an "
-                  "edge in the sweep before (default 0.01; 0 moves every vertex every sweep)")
+                  "Untangling and shape stage: a sweep moves only the vertices near one that moved more than this "
+                  "fraction of an edge in the sweep before (the untangler: also near hexes below the margin that are "
+                  "not stuck; default 0.01; 0 moves every vertex every sweep)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--margin", a->margin, "Untangling target for the minimum scaled Jacobian (default 0.05)");
   cmd->add_flag("--no-worst", a->no_worst, "Skip the worst-element pass");

@@ -96,7 +96,7 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
     for (const InfeasibleSet& f : u.infeasible)
       infeasible.push_back({{"kind", to_string(f.kind)}, {"vertex", f.vertex}, {"hexes", f.hexes}});
     j["untangle"] = {{"iterations", u.iterations}, {"min_sj", u.min_sj},         {"inverted", u.inverted},
-                     {"reached_margin", u.reached_margin}, {"lp_moves", u.lp_moves}, {"infeasible", infeasible},
+                     {"reached_margin", u.reached_margin}, {"lp_moves", u.lp_moves}, {"vertex_sweeps", u.vertex_sweeps}, {"infeasible", infeasible},
                      {"given_up", u.given_up},             {"stuck", u.stuck},       {"stop", u.stop},
                      {"seconds", r.untangle_seconds}};
     if (!u.infeasible.empty()) {

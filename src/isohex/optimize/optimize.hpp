@@ -104,6 +104,11 @@ struct UntangleOptions {
   int sweeps = 1;         ///< Gauss–Seidel sweeps per outer iteration (each vertex: two Newton steps)
   double lambda = 0.5;    ///< weight of the volume term (D² + 1)/χ
   int rings = 3;          ///< move only vertices within this many hex-rings of hexes below the margin
+  /// Culling: after the first iteration, move only the vertices of the hexes around a vertex
+  /// that moved more than this fraction of its mean edge in the iteration before, or around a
+  /// hex below the margin that is not stuck (0: every vertex within `rings`). The vertices
+  /// around stuck hexes settle after a few iterations and were swept again for the rest.
+  double cull = 0.01;
   /// Lowest relative decrease σ assumed by the ε schedule (ε's worst-frame χ shrinks by 1 − σ
   /// per iteration).
   double min_decrease = 0.5;
@@ -180,6 +185,9 @@ struct UntangleResult {
   std::size_t inverted = 0;        ///< hexes with scaled Jacobian <= 0 after (all of them, given up or not)
   bool reached_margin = false;     ///< every hex not given up reached the margin
   std::size_t lp_moves = 0;        ///< max–min LP moves taken when the barrier stalled
+  /// Vertices swept, summed over the iterations (each sweep up to two Newton steps per vertex):
+  /// the work, which UntangleOptions::cull lowers.
+  std::size_t vertex_sweeps = 0;
   /// find_infeasible()'s proofs, and for each one hex that the untangler gives up (leaves out
   /// of its energy so that the rest can be untangled; chosen per proof as the lowest scaled
   /// Jacobian among its hexes, then lowest id, until the rest of the proof's frames admit a
