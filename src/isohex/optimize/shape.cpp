@@ -67,7 +67,6 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   });
   // Culling: a sweep moves only the vertices near one that moved more than `cull` of its edge
   // length in the sweep before (the rest are held, as in `frozen`).
-  // (Once every vertex is held, the next sweep moves them all again before the stop test holds.)
   std::vector<double> scale(mesh.points.size());
   for (Index v = 0; v < mesh.num_vertices(); ++v) scale[v] = opt::vertex_length(inc, inv_len, v);
   const double cull = options.cull;
@@ -78,7 +77,6 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
     params.surface = options.surface;
     params.rank_guard = options.rank_guard;
     params.hex_ratio = keep_ratios ? &ratio : nullptr;
-    const bool full = res.culled == 0;  // this sweep moves every free vertex
     before = mesh.points;
     const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, held, 1);
     std::fill(changed.begin(), changed.end(), 0);
@@ -112,14 +110,7 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
     min_sj = s.min;
     // The objective alone would stop while the minimum still climbs (Mesquite's pave1: 0.12
     // after 42 sweeps at 1e-4, 0.39 after 78), and the minimum is what the user sees.
-    if ((rel < options.tol && !(sj_gain >= options.min_sj_gain)) || grad < options.grad_tol) {
-      // Stopped only by a sweep of every vertex: a culled sweep gains less by construction
-      // (cthead's bone, iso 1200, h 3.5, stopped 10 sweeps early and its rounds then left 11
-      // hexes below 0.2 and one not valid inside, where the full sweeps left none).
-      if (full) break;
-      held = frozen;
-      res.culled = 0;
-    }
+    if ((rel < options.tol && !(sj_gain >= options.min_sj_gain)) || grad < options.grad_tol) break;
   }
   return res;
 }
