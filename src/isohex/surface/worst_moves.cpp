@@ -32,8 +32,15 @@ struct Score {
   std::array<double, kMax> v{};
   int n = 0;
   double cap = 1;  // values above it count as it: good enough, free to trade
-  void add(double x) {
-    if (n < kMax) v[static_cast<std::size_t>(n++)] = std::min(x, cap);
+  bool lost = false;  // stopped early: a value fell below a rival's least, so it cannot beat it
+  // Adds x; false (and `lost`) once x is below the least value of `rival` (sorted), whatever
+  // comes after: then v sorted starts below the rival's and beats() would say no.
+  bool add(double x, const Score* rival = nullptr) {
+    if (n >= kMax) return true;
+    const double y = std::min(x, cap);
+    v[static_cast<std::size_t>(n++)] = y;
+    if (rival && rival->n > 0 && y < rival->v[0] - 1e-12) lost = true;
+    return !lost;
   }
   void finish() { std::sort(v.begin(), v.begin() + n); }
   [[nodiscard]] double min() const { return n > 0 ? v[0] : 1.0; }
@@ -94,7 +101,11 @@ double fan_margin(const HexMesh& mesh, const SurfaceGraph& graph, Index b, Index
 
 namespace {
 
-Score score_around(const MoveContext& ctx, Index v, const Vec3& y, const std::vector<Vec3>& turned, double cap) {
+// With a rival, stops (Score::lost) at the first value below the rival's least: most trial
+// points of the max–min search lose on their first quad or fan, and the rest of their fans
+// were a third of the surface smoothing's time on cthead h 2.
+Score score_around(const MoveContext& ctx, Index v, const Vec3& y, const std::vector<Vec3>& turned, double cap,
+                   const Score* rival = nullptr) {
   const auto& vq = ctx.graph.vertex_quads;
   Score s;
   s.cap = cap;
@@ -107,12 +118,13 @@ Score score_around(const MoveContext& ctx, Index v, const Vec3& y, const std::ve
     const Vec3 now = ref.squaredNorm() > 0 ? ref
                                           : Vec3((ctx.mesh.points[q[2]] - ctx.mesh.points[q[0]])
                                                      .cross(ctx.mesh.points[q[3]] - ctx.mesh.points[q[1]]));
-    s.add(oriented_quad_sj(quad_corners(ctx.mesh, q, v, y), now));
+    if (!s.add(oriented_quad_sj(quad_corners(ctx.mesh, q, v, y), now), rival)) return s;
   }
   // The fans whose corners move with v: its own and its edge neighbours'.
-  s.add(fan_margin(ctx, v, v, y));
+  if (!s.add(fan_margin(ctx, v, v, y), rival)) return s;
   const auto& nb = ctx.graph.boundary_neighbours;
-  for (Index k = nb.offsets[v]; k < nb.offsets[v + 1]; ++k) s.add(fan_margin(ctx, nb.ids[k], v, y));
+  for (Index k = nb.offsets[v]; k < nb.offsets[v + 1]; ++k)
+    if (!s.add(fan_margin(ctx, nb.ids[k], v, y), rival)) return s;
   s.finish();
   return s;
 }
@@ -163,8 +175,8 @@ MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int
       const double t = 2 * std::numbers::pi * d / kDirections;
       Vec3 y = x + step * (std::cos(t) * a + std::sin(t) * b);
       if (!constrain(ctx, v, y, 2 * edge) || !within_travel(ctx, v, y)) continue;
-      const Score value = score_around(ctx, v, y, turned, cap);
-      if (value.beats(best_score) && hexes_allow(ctx, v, y)) {
+      const Score value = score_around(ctx, v, y, turned, cap, &best_score);
+      if (!value.lost && value.beats(best_score) && hexes_allow(ctx, v, y)) {
         best_score = value;
         best = y;
       }
