@@ -483,4 +483,18 @@ void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& o
   });
 }
 
+void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const std::vector<Vec3>& before,
+                    const std::vector<double>& scale, double cull, std::vector<std::uint8_t>& near,
+                    std::vector<std::uint8_t>* changed) {
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (mesh.points[v] == before[v]) continue;
+    const bool far = (mesh.points[v] - before[v]).norm() > cull * scale[v];
+    for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+      if (changed) (*changed)[inc.ids[i]] = 1;
+      if (far)
+        for (Index w : mesh.hexes[inc.ids[i]]) near[w] = 1;
+    }
+  }
+}
+
 }  // namespace isohex::opt

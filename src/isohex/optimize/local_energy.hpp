@@ -204,6 +204,12 @@ SJStats sj_stats(const HexMesh& mesh, const std::vector<std::uint8_t>* skip = nu
 SJStats sj_stats_of(const std::vector<double>& sj, const std::vector<std::uint8_t>* skip = nullptr);
 /// certified_scaled_jacobian() of the hexes flagged in `only`, into sj (parallel).
 void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::vector<double>& sj);
+/// Culling, shared by the untangler and the shape stage: flags in `near` the vertices of the hexes
+/// around each vertex that moved more than cull × scale[v] from before[v]; with `changed`, the
+/// hexes around every vertex that moved at all. Neither is cleared first.
+void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const std::vector<Vec3>& before,
+                    const std::vector<double>& scale, double cull, std::vector<std::uint8_t>& near,
+                    std::vector<std::uint8_t>* changed = nullptr);
 
 /// The corners of hex h with its vertex v placed at x.
 inline std::array<Vec3, 8> corners_with(const HexMesh& mesh, Index h, Index v, const Vec3& x) {

@@ -81,15 +81,7 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
     const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, held, 1);
     std::fill(changed.begin(), changed.end(), 0);
     std::fill(active.begin(), active.end(), 0);
-    for (Index v = 0; v < mesh.num_vertices(); ++v) {
-      if (mesh.points[v] == before[v]) continue;
-      const bool far = (mesh.points[v] - before[v]).norm() > cull * scale[v];
-      for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
-        changed[inc.ids[i]] = 1;
-        if (far)
-          for (Index w : mesh.hexes[inc.ids[i]]) active[w] = 1;
-      }
-    }
+    opt::mark_far_moves(mesh, inc, before, scale, cull, active, &changed);
     res.culled = 0;
     if (cull > 0)
       for (Index v = 0; v < mesh.num_vertices(); ++v) {

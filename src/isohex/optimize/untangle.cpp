@@ -184,12 +184,9 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   const double cull = options.cull;
   std::vector<double> scale(cull > 0 ? mesh.points.size() : 0);
   for (std::size_t v = 0; v < scale.size(); ++v) scale[v] = opt::vertex_length(inc, inv_len, static_cast<Index>(v));
-  std::vector<std::uint8_t> moved, near(mesh.points.size());
+  std::vector<std::uint8_t> near(mesh.points.size());
+  bool culling = false;  // `near` holds the last sweep's far moves
   std::vector<Vec3> before;
-  const auto mark_around = [&](Index v) {
-    for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
-      for (Index w : mesh.hexes[inc.ids[i]]) near[w] = 1;
-  };
   for (int it = 1; it <= options.max_iter; ++it) {
     for (std::size_t h = 0; h < sj.size(); ++h) {
       const std::uint8_t b = sj[h] <= 0 || is_degenerate(sj[h]);
@@ -198,13 +195,12 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
       if (b) interior[h] = 1;
     }
     std::vector<std::uint8_t> frozen = frozen_outside(mesh, inc, sj, options.margin, options.rings, skipped);
-    if (!moved.empty()) {
-      std::fill(near.begin(), near.end(), 0);
-      for (Index v = 0; v < mesh.num_vertices(); ++v)
-        if (moved[v]) mark_around(v);
+    if (culling) {
       for (Index h = 0; h < mesh.num_hexes(); ++h)
         if ((!skipped || !skip[h]) && hex_eps[h] == 0 && (sj[h] < options.margin || is_degenerate(sj[h])))
-          for (Index v : mesh.hexes[h]) mark_around(v);
+          for (Index v : mesh.hexes[h])
+            for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+              for (Index w : mesh.hexes[inc.ids[i]]) near[w] = 1;
       for (Index v = 0; v < mesh.num_vertices(); ++v) frozen[v] |= !near[v];
     }
     const std::vector<std::uint8_t> touched = touched_hexes(mesh, frozen);
@@ -215,9 +211,9 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     res.vertex_sweeps += static_cast<std::size_t>(options.sweeps) *
                          static_cast<std::size_t>(std::count(frozen.begin(), frozen.end(), std::uint8_t{0}));
     if (cull > 0) {
-      moved.assign(mesh.points.size(), 0);
-      for (Index v = 0; v < mesh.num_vertices(); ++v)
-        moved[v] = mesh.points[v] != before[v] && (mesh.points[v] - before[v]).norm() > cull * scale[v];
+      std::fill(near.begin(), near.end(), 0);
+      opt::mark_far_moves(mesh, inc, before, scale, cull, near);
+      culling = true;
     }
     opt::hex_energies(mesh, inv_len, params, energy_skip, hex_e, &touched);
     const double e_after = sum_over(touched);
@@ -303,7 +299,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
         best_inverted = std::min(best_inverted, after.inverted);
         sj = certified_scaled_jacobians(mesh);
         std::fill(det_stale.begin(), det_stale.end(), 1);  // the LP moved vertices anywhere
-        moved.clear();  // and the next iteration moves every vertex again
+        culling = false;  // and the next iteration moves every vertex again
         since_progress = 0;  // a new window from here
       }
     }
