@@ -249,6 +249,8 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
   OptimizeOptions rounds = o;
   rounds.worst_options.passes = std::max(o.worst_options.passes, 100);
   const Incidence inc = vertex_hexes(mesh);
+  // One incidence for the rounds and every stage in them (the connectivity does not change).
+  rounds.untangle_options.incidence = rounds.shape_options.incidence = rounds.worst_options.incidence = &inc;
   RoundScore score;
   std::vector<double> sj = round_ranks(mesh, score);
   for (int round = 1; round <= 5; ++round) {
@@ -267,13 +269,13 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
       if (n > 0 || reach == kMaxReach) break;
       rings.grow();
     }
-    const std::vector<Vec3> points = mesh.points;
     if (n == 0) break;
     fmt::print("boundary: {} vertices of hexes below 0.2 released into a band of {:.3g} about their surface; "
                "optimising again\n", n, band);
     std::vector<std::uint8_t> held = frozen_outside(mesh, inc, sj, kQuestionableSJ, kRings);
     const std::vector<std::uint8_t> pinned = surface.fixed_mask();
     for (std::size_t v = 0; v < held.size(); ++v) held[v] = held[v] || pinned[v];
+    const PointSnapshot points(mesh, held);  // the round moves none of the held vertices
     nlohmann::json again = run_optimisation(mesh, held, rounds);
     again["released"] = n;
     RoundScore after;
@@ -284,7 +286,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
       // after it too.
       fmt::print("boundary: round {} left the mesh worse ({} below 0.2, min SJ {:.4f}; before it {}, {:.4f}); "
                  "again without the shape stage\n", round, after.below, after.min_sj, score.below, score.min_sj);
-      mesh.points = points;
+      points.restore(mesh);
       surface = saved;
       surface.loosen(mesh, candidates, band);
       rounds.shape_options.max_iter = 0;
@@ -292,7 +294,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
       next = round_ranks(mesh, after);
     }
     if (after.worse_than(score)) {
-      mesh.points = points;
+      points.restore(mesh);
       surface = saved;
       fmt::print("boundary: round {} undone ({} below 0.2, min SJ {:.4f}; before it {}, {:.4f})\n", round, after.below,
                  after.min_sj, score.below, score.min_sj);

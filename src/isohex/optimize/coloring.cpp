@@ -1,4 +1,4 @@
-// Fixed-vertex masks and the vertex colouring behind the parallel Gauss–Seidel sweeps.
+// Fixed-vertex masks, snapshots of the free vertices and the vertex colouring behind the parallel Gauss–Seidel sweeps.
 #include "isohex/mesh/topology.hpp"
 #include "isohex/optimize/optimize.hpp"
 
@@ -19,8 +19,9 @@ std::vector<std::uint8_t> fixed_mask(const HexMesh& mesh, FixedVertices which) {
   return std::vector<std::uint8_t>(mesh.points.size(), 0);
 }
 
-VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed) {
-  const Incidence inc = vertex_hexes(mesh);
+VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const Incidence* given) {
+  Incidence own;
+  const Incidence& inc = given ? *given : (own = vertex_hexes(mesh));
   std::vector<int> color(mesh.points.size(), -1);
   std::vector<Index> stamp;  // stamp[c] == v: colour c is taken by a neighbour of v
   VertexColoring out;
@@ -40,6 +41,21 @@ VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_
     out.colors[c].push_back(v);  // v ascending: each colour's list is sorted
   }
   return out;
+}
+
+PointSnapshot::PointSnapshot(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed) {
+  for (Index v = 0; v < mesh.num_vertices(); ++v)
+    if (fixed.empty() || !fixed[v]) ids_.push_back(v);
+  at_.resize(ids_.size());
+  take(mesh);
+}
+
+void PointSnapshot::take(const HexMesh& mesh) {
+  for (std::size_t i = 0; i < ids_.size(); ++i) at_[i] = mesh.points[ids_[i]];
+}
+
+void PointSnapshot::restore(HexMesh& mesh) const {
+  for (std::size_t i = 0; i < ids_.size(); ++i) mesh.points[ids_[i]] = at_[i];
 }
 
 }  // namespace isohex

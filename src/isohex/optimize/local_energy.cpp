@@ -75,7 +75,7 @@ struct Scalar {
 };
 
 // Regularised energy (ε > 0): finite for every D, so the untangler may cross inverted states.
-Scalar untangle_term(double F, double D, double eps, double lambda) {
+[[gnu::always_inline]] inline Scalar untangle_term(double F, double D, double eps, double lambda) {
   const double s = std::sqrt(eps * eps + D * D);
   // (D + s)/2 cancels for D << 0; the same value as ε²/(2(s − D)) there.
   const double chi = D >= 0 ? 0.5 * (D + s) : eps * eps / (2 * (s - D));
@@ -95,7 +95,7 @@ Scalar untangle_term(double F, double D, double eps, double lambda) {
 }
 
 // Knupp's inverse mean ratio F / (3 D^{2/3}); a barrier: +inf unless D is safely positive.
-Scalar shape_term(double F, double D) {
+[[gnu::always_inline]] inline Scalar shape_term(double F, double D) {
   Scalar r;
   if (!(D > kMinFeasibleDet)) {
     r.f = kInf;
@@ -111,7 +111,7 @@ Scalar shape_term(double F, double D) {
   return r;
 }
 
-Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
+[[gnu::always_inline]] inline Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
   const double F = A.squaredNorm(), D = A.determinant();
   if (params.untangle) return untangle_term(F, D, eps, params.lambda);
   if (t >= kCentreFrame) {  // the centre and interior frames only constrain (validity), they are not optimised
@@ -205,30 +205,21 @@ std::vector<double> inverse_edge_lengths(const HexMesh& mesh) {
   return inv;
 }
 
-Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
-  Mat3 A;
-  if (t < 8) {
-    const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
-    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
-  } else if (t == kCentreFrame) {
-    A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
-    A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
-    A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
-  } else {
-    // Σ_k (P_k − P_0) c_{t,k}ᵀ (Σ c_k = 0: relative to P0), entry by entry in k order, then
-    // scaled: the arithmetic of the matrix expression `A += (P_k − P_0) c_kᵀ`, whose
-    // temporaries on the stack stalled every load (most of frame()'s samples on cthead).
-    double a[3][3] = {};
-    const auto& coef = kCoef[static_cast<std::size_t>(t)];
-    for (int k = 0; k < 8; ++k) {
-      const double d[3] = {p[k][0] - p[0][0], p[k][1] - p[0][1], p[k][2] - p[0][2]};
-      const Vec3& c = coef[static_cast<std::size_t>(k)];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) a[i][j] += d[i] * c[j];
-    }
+Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+  // Σ_k (P_k − P_0) c_{t,k}ᵀ (Σ c_k = 0: relative to P0), entry by entry in k order, then
+  // scaled: the arithmetic of the matrix expression `A += (P_k − P_0) c_kᵀ`, whose
+  // temporaries on the stack stalled every load (most of frame()'s samples on cthead).
+  double a[3][3] = {};
+  const auto& coef = kCoef[static_cast<std::size_t>(t)];
+  for (int k = 0; k < 8; ++k) {
+    const double d[3] = {p[k][0] - p[0][0], p[k][1] - p[0][1], p[k][2] - p[0][2]};
+    const Vec3& c = coef[static_cast<std::size_t>(k)];
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;
+      for (int j = 0; j < 3; ++j) a[i][j] += d[i] * c[j];
   }
+  Mat3 A;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;
   return A;
 }
 
@@ -277,6 +268,62 @@ bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector
   return true;
 }
 
+namespace {
+
+// How frame t's coefficient c_{t,k} is made: a unit vector e_j (corner k is the j-th neighbour
+// of corner t), (−1, −1, −1) (frame t is corner k's own) or anything else (the centre and
+// interior frames). The gradient of det A needs one cross product for e_j instead of three;
+// the arithmetic is that of the general formula with its zero terms left out, so the same
+// bits (vertex_energy() was about half of the shape stage's time).
+enum class CoefKind : std::uint8_t { zero, unit0, unit1, unit2, own, general };
+
+const std::array<std::array<CoefKind, 8>, kAllFrames> kKinds = [] {
+  std::array<std::array<CoefKind, 8>, kAllFrames> kinds;
+  for (int t = 0; t < kAllFrames; ++t)
+    for (int k = 0; k < 8; ++k) {
+      const Vec3& c = kCoef[t][k];
+      CoefKind kind = CoefKind::general;
+      if (c.isZero()) kind = CoefKind::zero;
+      else if (c == Vec3(-1, -1, -1)) kind = CoefKind::own;
+      else
+        for (int j = 0; j < 3; ++j)
+          if (c == Vec3::Unit(j)) kind = static_cast<CoefKind>(static_cast<int>(CoefKind::unit0) + j);
+      kinds[t][k] = kind;
+    }
+  return kinds;
+}();
+
+// d/dx of F = |A|² and of D = det A when A changes by il·dx cᵀ (c of kind `kind`).
+[[gnu::always_inline]] inline void frame_gradients(const Mat3& A, const Vec3& c, CoefKind kind, double il, Vec3& gF, Vec3& gD) {
+  switch (kind) {
+    case CoefKind::unit0:
+    case CoefKind::unit1:
+    case CoefKind::unit2: {
+      const int j = static_cast<int>(kind) - static_cast<int>(CoefKind::unit0);
+      gF = 2 * il * A.col(j);
+      gD = il * A.col((j + 1) % 3).cross(A.col((j + 2) % 3));
+      return;
+    }
+    case CoefKind::own:
+      gF = 2 * il * (A * c);  // Eigen's product (its own order of sums)
+      gD = il * (-A.col(1).cross(A.col(2)) - A.col(2).cross(A.col(0)) - A.col(0).cross(A.col(1)));
+      return;
+    default:
+      gF = 2 * il * (A * c);
+      gD = il * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) + c[2] * A.col(0).cross(A.col(1)));
+  }
+}
+
+// H += fFD (gF gDᵀ + gD gFᵀ) + fDD gD gDᵀ, entry by entry: the operations of the matrix
+// expression (whose scalar factor Eigen applies to the outer product's left vector), without
+// its temporaries.
+[[gnu::always_inline]] inline void add_hessian(const Scalar& s, const Vec3& gF, const Vec3& gD, Mat3& H) {
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) H(i, j) += s.fFD * (gF[i] * gD[j] + gD[i] * gF[j]) + (s.fDD * gD[i]) * gD[j];
+}
+
+}  // namespace
+
 double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                      const Vec3& x, const EnergyParams& params, Vec3* g, Mat3* H) {
   double e = 0;
@@ -292,22 +339,35 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     const double il = inv_len[h];
     const double eps = params.eps_of(h);
     const int frames = params.frames_of(h);
-    for (int t = 0; t < frames; ++t) {
-      const Vec3& c = kCoef[t][k];
-      if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
-      const Mat3 A = frame(p, t, il);
+    // One frame's term (false: the energy is infinite). Inlined into each branch below, so that
+    // a corner frame stays in registers: merged through memory, its reload after the stores
+    // stalled (a tenth of the function's samples).
+    const auto visit = [&](const Mat3& A, int t, CoefKind kind) __attribute__((always_inline)) {
       const Scalar s = term(A, t, params, eps);
       e += s.f;
-      if (!std::isfinite(e)) return kInf;
-      if (!g) continue;
-      // d/dx of F and D: A changes by il·dx cᵀ.
-      const Vec3 gF = 2 * il * (A * c);
-      const Vec3 gD = il * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) +
-                            c[2] * A.col(0).cross(A.col(1)));
+      if (!std::isfinite(e)) return false;
+      // The shape stage's centre and interior frames only constrain: no derivatives.
+      if (!g || (!params.untangle && t >= kCentreFrame)) return true;
+      const Vec3& c = kCoef[t][k];
+      Vec3 gF, gD;
+      frame_gradients(A, c, kind, il, gF, gD);
       *g += s.fF * gF + s.fD * gD;
       if (H) {
         *H += (s.fF * 2 * il * il * c.squaredNorm()) * Mat3::Identity();
-        *H += s.fFD * (gF * gD.transpose() + gD * gF.transpose()) + s.fDD * (gD * gD.transpose());
+        add_hessian(s, gF, gD, *H);
+      }
+      return true;
+    };
+    for (int t = 0; t < frames; ++t) {
+      const CoefKind kind = kKinds[t][k];
+      if (kind == CoefKind::zero) continue;  // frame t does not see vertex v: its term is a constant
+      if (t < 8) {
+        Mat3 A;
+        const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
+        for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * il;  // frame()'s arithmetic
+        if (!visit(A, t, kind)) return kInf;
+      } else if (!visit(frame(p, t, il), t, kind)) {
+        return kInf;
       }
     }
     if (params.bernstein_of(h)) {
@@ -483,12 +543,13 @@ void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& o
   });
 }
 
-void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const std::vector<Vec3>& before,
+void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const PointSnapshot& before,
                     const std::vector<double>& scale, double cull, std::vector<std::uint8_t>& near,
                     std::vector<std::uint8_t>* changed) {
-  for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    if (mesh.points[v] == before[v]) continue;
-    const bool far = (mesh.points[v] - before[v]).norm() > cull * scale[v];
+  for (std::size_t k = 0; k < before.vertices().size(); ++k) {
+    const Index v = before.vertices()[k];
+    if (mesh.points[v] == before.place(k)) continue;
+    const bool far = (mesh.points[v] - before.place(k)).norm() > cull * scale[v];
     for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
       if (changed) (*changed)[inc.ids[i]] = 1;
       if (far)

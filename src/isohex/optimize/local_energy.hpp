@@ -110,8 +110,26 @@ inline double inverse_cbrt(double x) {
 /// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
 std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
 
-/// Frame t of corners p (already the hex's corners), scaled by inv_len.
-Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len);
+/// Frame t >= kFrames (an interior one) of corners p, scaled by inv_len (frame()).
+Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
+
+/// Frame t of corners p (already the hex's corners), scaled by inv_len. Inline: out of line,
+/// its result went through memory as scalar stores read back as vector loads, a stall at every
+/// frame of the energies' innermost loops (a tenth of vertex_energy()'s samples on cthead h 2).
+[[gnu::always_inline]] inline Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+  Mat3 A;
+  if (t < 8) {
+    const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
+    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
+  } else if (t == kCentreFrame) {
+    A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
+    A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
+    A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
+  } else {
+    A = interior_frame(p, t, inv_len);
+  }
+  return A;
+}
 
 /// The coefficient c_{t,k} of corner k in frame t (zero when frame t does not use corner k).
 const Vec3& frame_coefficient(int t, int k);
@@ -205,11 +223,20 @@ SJStats sj_stats_of(const std::vector<double>& sj, const std::vector<std::uint8_
 /// certified_scaled_jacobian() of the hexes flagged in `only`, into sj (parallel).
 void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::vector<double>& sj);
 /// Culling, shared by the untangler and the shape stage: flags in `near` the vertices of the hexes
-/// around each vertex that moved more than cull × scale[v] from before[v]; with `changed`, the
-/// hexes around every vertex that moved at all. Neither is cleared first.
-void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const std::vector<Vec3>& before,
+/// around each vertex that moved more than cull × scale[v] from its place in `before`; with
+/// `changed`, the hexes around every vertex that moved at all. Neither is cleared first.
+void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const PointSnapshot& before,
                     const std::vector<double>& scale, double cull, std::vector<std::uint8_t>& near,
                     std::vector<std::uint8_t>* changed = nullptr);
+
+/// The caller's incidence if it gave one (it must be vertex_hexes(mesh)), else one built into
+/// `own`: the stages of one optimisation share one instead of each holding its own (21 MB on
+/// cthead h 2, two or three of them alive at once).
+inline const Incidence& incidence_of(const HexMesh& mesh, const Incidence* given, Incidence& own) {
+  if (given) return *given;
+  own = vertex_hexes(mesh);
+  return own;
+}
 
 /// The corners of hex h with its vertex v placed at x.
 inline std::array<Vec3, 8> corners_with(const HexMesh& mesh, Index h, Index v, const Vec3& x) {

@@ -78,8 +78,26 @@ std::vector<std::uint8_t> fixed_mask(const HexMesh& mesh, FixedVertices which);
 struct VertexColoring {
   std::vector<std::vector<Index>> colors;  ///< free vertex ids per colour, ascending
 };
-/// Greedy colouring in vertex order (deterministic). Fixed vertices are left out.
-VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed);
+/// Greedy colouring in vertex order (deterministic). Fixed vertices are left out. `inc`:
+/// vertex_hexes(mesh) if the caller has it (null: built here).
+VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
+                              const Incidence* inc = nullptr);
+
+/// The places of the vertices an optimisation may move (those not flagged in `fixed`), to
+/// compare with or go back to: a copy of those alone. A band round holds all but a few thousand of cthead h
+/// 2's 630,000 vertices, and whole copies of the points were 15 MB each.
+class PointSnapshot {
+ public:
+  PointSnapshot(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed);
+  void take(const HexMesh& mesh);     ///< the places now
+  void restore(HexMesh& mesh) const;  ///< back to the places taken
+  const std::vector<Index>& vertices() const { return ids_; }  ///< ascending
+  const Vec3& place(std::size_t i) const { return at_[i]; }     ///< of vertices()[i]
+
+ private:
+  std::vector<Index> ids_;
+  std::vector<Vec3> at_;
+};
 
 /// One line of progress.
 struct IterationReport {
@@ -128,6 +146,8 @@ struct UntangleOptions {
   double stall_fraction = 0.05;  ///< ... (fewer inverted: by this fraction of them, at least 1)
   int rescues = 5;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
+  /// vertex_hexes(mesh) if the caller has it, to share (null: built here).
+  const Incidence* incidence = nullptr;
   ProgressCallback progress;
 };
 
@@ -220,6 +240,8 @@ struct ShapeOptions {
   /// sweep). cthead h 3: sweeps 26.3 -> 9.8 s, mean scaled Jacobian 0.9000 -> 0.8997.
   double cull = 1e-2;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
+  /// vertex_hexes(mesh) if the caller has it, to share (null: built here).
+  const Incidence* incidence = nullptr;
   /// No step takes a hex's rank, the lower of its certified scaled Jacobian and twice its
   /// jacobian ratio bound, below the lower of its rank before the step and this (-inf: off).
   /// The mean objective otherwise trades minima for the mean: `isohex mesh`'s band rounds set
@@ -313,6 +335,8 @@ struct WorstOptions {
   int search_rings = 2;
   std::size_t search_vertices = 400;
   const BoundarySurface* surface = nullptr;  ///< boundary vertices that slide on it (null: none)
+  /// vertex_hexes(mesh) if the caller has it, to share (null: built here).
+  const Incidence* incidence = nullptr;
   ProgressCallback progress;
 };
 
@@ -336,6 +360,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
 
 /// The whole sequence `isohex smooth` and `isohex mesh` run: untangle (optional), shape, worst
 /// pass (optional), with one fixed-vertex mask. One function, so both commands behave the same.
+/// The stages share one incidence (their options' `incidence`, else one built here).
 struct OptimizeOptions {
   bool untangle = true;
   bool worst = true;

@@ -45,8 +45,9 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
     ++res.frozen_hexes;
     for (Index v : mesh.hexes[h]) frozen[v] = 1;
   }
-  const Incidence inc = vertex_hexes(mesh);
-  const VertexColoring coloring = color_vertices(mesh, fixed);
+  Incidence own_inc;
+  const Incidence& inc = opt::incidence_of(mesh, options.incidence, own_inc);
+  const VertexColoring coloring = color_vertices(mesh, fixed, &inc);
   // The objective and the scaled Jacobians per hex, evaluated again after a sweep only where a
   // vertex moved (the same values, summed in hex order: the same bits as whole-mesh passes).
   std::size_t terms = 0;
@@ -71,13 +72,13 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   for (Index v = 0; v < mesh.num_vertices(); ++v) scale[v] = opt::vertex_length(inc, inv_len, v);
   const double cull = options.cull;
   std::vector<std::uint8_t> held = frozen, changed(mesh.hexes.size(), 0), active(mesh.points.size());
-  std::vector<Vec3> before;
+  PointSnapshot before(mesh, fixed);
   for (int it = 1; it <= options.max_iter; ++it) {
     opt::EnergyParams params;
     params.surface = options.surface;
     params.rank_guard = options.rank_guard;
     params.hex_ratio = keep_ratios ? &ratio : nullptr;
-    before = mesh.points;
+    before.take(mesh);
     const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, held, 1);
     std::fill(changed.begin(), changed.end(), 0);
     std::fill(active.begin(), active.end(), 0);

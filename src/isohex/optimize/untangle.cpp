@@ -136,8 +136,9 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     return finish(stats);
   }
 
-  const Incidence inc = vertex_hexes(mesh);
-  const VertexColoring coloring = color_vertices(mesh, fixed);
+  Incidence own_inc;
+  const Incidence& inc = opt::incidence_of(mesh, options.incidence, own_inc);
+  const VertexColoring coloring = color_vertices(mesh, fixed, &inc);
   const std::vector<double> inv_len = opt::inverse_edge_lengths(mesh);
   // Hexes that have not been valid inside count their interior frames too (from the first
   // time they are seen so, to the end): the 9 frames alone cannot see their fold.
@@ -164,7 +165,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   // The best state seen (fewest inverted hexes, then highest minimum): the energy is global,
   // so an iteration can trade the worst hex for the rest; a failed run must not end worse
   // than it could have.
-  std::vector<Vec3> best_points = mesh.points;
+  PointSnapshot best_points(mesh, fixed);
   opt::SJStats best = stats;
   res.stop = "max_iter";
   // Per iteration only the hexes a sweep can change (touched_hexes()) are evaluated: their
@@ -186,7 +187,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   for (std::size_t v = 0; v < scale.size(); ++v) scale[v] = opt::vertex_length(inc, inv_len, static_cast<Index>(v));
   std::vector<std::uint8_t> near(mesh.points.size());
   bool culling = false;  // `near` holds the last sweep's far moves
-  std::vector<Vec3> before;
+  PointSnapshot before(mesh, cull > 0 ? fixed : std::vector<std::uint8_t>(mesh.points.size(), 1));
   for (int it = 1; it <= options.max_iter; ++it) {
     for (std::size_t h = 0; h < sj.size(); ++h) {
       const std::uint8_t b = sj[h] <= 0 || is_degenerate(sj[h]);
@@ -206,7 +207,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     const std::vector<std::uint8_t> touched = touched_hexes(mesh, frozen);
     opt::hex_energies(mesh, inv_len, params, energy_skip, hex_e, &touched);  // at this ε
     const double e_before = sum_over(touched);
-    if (cull > 0) before = mesh.points;
+    if (cull > 0) before.take(mesh);
     for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2);
     res.vertex_sweeps += static_cast<std::size_t>(options.sweeps) *
                          static_cast<std::size_t>(std::count(frozen.begin(), frozen.end(), std::uint8_t{0}));
@@ -227,7 +228,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     }
     if (stats.inverted < best.inverted || (stats.inverted == best.inverted && stats.min > best.min)) {
       best = stats;
-      best_points = mesh.points;
+      best_points.take(mesh);
     }
     if (stats.min >= options.margin) {
       res.reached_margin = true;
@@ -283,18 +284,18 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
         }
         ++rescues;
         // From the best state: the rescue should work on the fewest inverted hexes.
-        mesh.points = best_points;
+        best_points.restore(mesh);
         const std::size_t moves = lp_rescue(mesh, coloring, inc, inv_len, skipped, options.surface);
         const opt::SJStats after = opt::sj_stats(mesh, skipped);
         if (options.progress) options.progress({"lp", rescues, static_cast<double>(moves), after.min, after.inverted});
         if (!(after.inverted < best.inverted || (after.inverted == best.inverted && after.min > best.min))) {
-          mesh.points = best_points;  // the rescue gained nothing
+          best_points.restore(mesh);  // the rescue gained nothing
           res.stop = "stall";
           break;
         }
         res.lp_moves += moves;
         best = after;
-        best_points = mesh.points;
+        best_points.take(mesh);
         stats = after;
         best_inverted = std::min(best_inverted, after.inverted);
         sj = certified_scaled_jacobians(mesh);
@@ -312,7 +313,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   }
   res.stalled = res.stop == "stall";
   if (!res.reached_margin) {
-    mesh.points.swap(best_points);
+    best_points.restore(mesh);
     stats = best;
   }
   return finish(stats);

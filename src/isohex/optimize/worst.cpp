@@ -293,7 +293,8 @@ bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector
 
 WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const WorstOptions& options) {
   WorstResult res;
-  const Incidence inc = vertex_hexes(mesh);
+  Incidence own_inc;
+  const Incidence& inc = opt::incidence_of(mesh, options.incidence, own_inc);
   std::vector<double> sj(mesh.hexes.size());
   // The pass works on the hexes lowest in `rank`: the scaled Jacobian, or with ratio_terms the
   // lower of it and the hex's Bernstein ratio bound.

@@ -17,6 +17,12 @@ namespace isohex {
 
 namespace {
 
+bool all_finite(const std::array<Vec3, 8>& p) {
+  for (const Vec3& x : p)
+    if (!x.allFinite()) return false;
+  return true;
+}
+
 // Corners relative to corner 0: det J is translation invariant, and differences keep the
 // digits of elements far from the origin.
 std::array<Vec3, 8> relative(const std::array<Vec3, 8>& p) {
@@ -44,6 +50,17 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
   return edge_u(p, v, w).dot(edge_v(p, u, w).cross(edge_w(p, u, v)));
 }
 
+// A bilinear blend of the edge vectors a (at parameters 0, 0), b (1, 0), c (0, 1) and d (1, 1)
+// at the 3×3 lattice of 0, 1/2, 1 (x[i + 3j] at (i/2, j/2)), but for the centre x[4], whose sum
+// the caller orders as edge_u() and the others do.
+void unit_lattice(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, std::array<Vec3, 9>& x) {
+  x[0] = a, x[2] = b, x[6] = c, x[8] = d;
+  x[1] = 0.5 * a + 0.5 * b;
+  x[7] = 0.5 * c + 0.5 * d;
+  x[3] = 0.5 * a + 0.5 * c;
+  x[5] = 0.5 * b + 0.5 * d;
+}
+
 // The 27 samples on the lattice of [lo, hi] and their Bernstein coefficients; `samples`
 // (values actually taken by det J) may be null. (The same values as det_at() at each point,
 // bit for bit: its edge vectors, each computed once.)
@@ -53,12 +70,23 @@ std::array<double, 27> bernstein_box(const std::array<Vec3, 8>& q, const Vec3& l
   const Vec3 mid = 0.5 * (lo + hi);
   const double us[3] = {lo[0], mid[0], hi[0]}, vs[3] = {lo[1], mid[1], hi[1]}, ws[3] = {lo[2], mid[2], hi[2]};
   std::array<Vec3, 9> xu, xv, xw;  // xu[j + 3k] at (v_j, w_k), xv[i + 3k] at (u_i, w_k), xw[i + 3j] at (u_i, v_j)
-  for (int b2 = 0; b2 < 3; ++b2)
-    for (int a = 0; a < 3; ++a) {
-      xu[a + 3 * b2] = edge_u(q, vs[a], ws[b2]);
-      xv[a + 3 * b2] = edge_v(q, us[a], ws[b2]);
-      xw[a + 3 * b2] = edge_w(q, us[a], vs[b2]);
-    }
+  if (lo == Vec3::Zero() && hi == Vec3::Ones()) {
+    // The whole element (most calls): edge_u() and the others at 0, 1/2 and 1 are its edges
+    // and their halves and quarters; the same sums in the same order without the zero terms.
+    unit_lattice(q[1] - q[0], q[2] - q[3], q[5] - q[4], q[6] - q[7], xu);
+    xu[4] = 0.25 * (q[1] - q[0]) + 0.25 * (q[2] - q[3]) + 0.25 * (q[5] - q[4]) + 0.25 * (q[6] - q[7]);
+    unit_lattice(q[3] - q[0], q[2] - q[1], q[7] - q[4], q[6] - q[5], xv);
+    xv[4] = 0.25 * (q[3] - q[0]) + 0.25 * (q[2] - q[1]) + 0.25 * (q[7] - q[4]) + 0.25 * (q[6] - q[5]);
+    unit_lattice(q[4] - q[0], q[5] - q[1], q[7] - q[3], q[6] - q[2], xw);
+    xw[4] = 0.25 * (q[4] - q[0]) + 0.25 * (q[5] - q[1]) + 0.25 * (q[6] - q[2]) + 0.25 * (q[7] - q[3]);
+  } else {
+    for (int b2 = 0; b2 < 3; ++b2)
+      for (int a = 0; a < 3; ++a) {
+        xu[a + 3 * b2] = edge_u(q, vs[a], ws[b2]);
+        xv[a + 3 * b2] = edge_v(q, us[a], ws[b2]);
+        xw[a + 3 * b2] = edge_w(q, us[a], vs[b2]);
+      }
+  }
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) b[i + 3 * j + 9 * k] = xu[j + 3 * k].dot(xv[i + 3 * k].cross(xw[i + 3 * j]));
@@ -248,11 +276,10 @@ std::array<double, 27> jacobian_bernstein(const std::array<Vec3, 8>& p, const Ve
 }
 
 JacobianBounds jacobian_bounds(const std::array<Vec3, 8>& p, const JacobianBoundOptions& options) {
-  for (const Vec3& x : p)
-    if (!x.allFinite()) {
-      const double nan = std::numeric_limits<double>::quiet_NaN();
-      return {nan, nan, nan, nan, 0};  // neither valid() nor invalid(): undecidable
-    }
+  if (!all_finite(p)) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {nan, nan, nan, nan, 0};  // neither valid() nor invalid(): undecidable
+  }
   return Subdivision(p).run(options);
 }
 
@@ -272,6 +299,12 @@ namespace {
 // coefficients; `ratio` (may be null) gets their ratio bound.
 bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivisions, double ratio_floor,
                      double* ratio = nullptr) {
+  // A non-finite corner is never valid (bernstein_box()'s whole-element path does not carry a
+  // NaN into every coefficient, and min_element() cannot see one).
+  if (!all_finite(p)) {
+    if (ratio) *ratio = -1;
+    return false;
+  }
   const std::array<Vec3, 8> q = relative(p);
   std::array<double, 27> s;
   const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
@@ -301,6 +334,11 @@ double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
 double jacobian_ratio_bound(const std::array<Vec3, 8>& p) { return ratio_bound(jacobian_bernstein(p)); }
 
 CertifiedQuality certified_quality(const std::array<Vec3, 8>& p) {
+  if (!all_finite(p)) {  // never certified (certified_above())
+    CertifiedQuality r{scaled_jacobian(p), -1};
+    if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0) r.scaled_jacobian = 0;
+    return r;
+  }
   const std::array<Vec3, 8> q = relative(p);
   std::array<double, 27> s;
   const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);

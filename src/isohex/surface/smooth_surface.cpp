@@ -148,15 +148,19 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
   std::vector<std::uint8_t> can_move(mesh.points.size(), 0);
   for (Index v : sliding) can_move[v] = 1;
   std::vector<MoveOutcome> outcome(mesh.points.size(), MoveOutcome::none);
+  std::vector<std::uint8_t> stale(mesh.points.size(), 1), active;
+  std::vector<Vec3> normal, turned;
+  std::vector<Index> work;
   for (int pass = 0; pass < options.worst_passes; ++pass) {
-    const std::vector<Vec3> turned = surface_detail::turned_over_quads(ctx, on_isosurface);
-    std::vector<std::uint8_t> active(mesh.points.size(), 0);
+    surface_detail::update_normals(ctx, on_isosurface, stale, normal);
+    surface_detail::turned_over_quads(ctx, normal, turned);
+    active.assign(mesh.points.size(), 0);
     for (std::size_t i = 0; i < ctx.graph.quads.size(); ++i) {
       const Quad& q = ctx.graph.quads[i];
       if (turned[i].squaredNorm() > 0 || quad_sj_of(mesh, q) < options.worst_target)
         for (Index v : q) active[v] = can_move[v];
     }
-    std::vector<Index> work;
+    work.clear();
     for (Index v : sliding)
       if (active[v]) work.push_back(v);
     if (work.empty()) break;
@@ -168,7 +172,12 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
             surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius, options.worst_levels, turned,
                                              options.worst_target);
       });
-      for (Index v : cls) moved += outcome[v] == MoveOutcome::accepted;
+      for (Index v : cls) {
+        if (outcome[v] != MoveOutcome::accepted) continue;
+        ++moved;
+        for (Index k = ctx.graph.vertex_quads.offsets[v]; k < ctx.graph.vertex_quads.offsets[v + 1]; ++k)
+          for (Index x : ctx.graph.quads[ctx.graph.vertex_quads.ids[k]]) stale[x] = 1;
+      }
     }
     report.worst_moves += moved;
     if (moved == 0) break;

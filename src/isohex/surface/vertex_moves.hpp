@@ -154,11 +154,19 @@ double fan_margin(const MoveContext& ctx, Index b, Index v, const Vec3& y);
 /// The same on any mesh and its graph.
 double fan_margin(const HexMesh& mesh, const SurfaceGraph& graph, Index b, Index v, const Vec3& y);
 
+/// The outward_normal() of each boundary vertex on the isosurface (`on_isosurface`), zero for
+/// the others, kept through moves: update_normals() recomputes those flagged in `stale` (and
+/// clears the flags); after a move of v, flag the vertices of its quads (a box-face vertex's
+/// normal comes from its quads). The field's gradient at every boundary vertex, in each of the
+/// worst-quad passes, was most of their sampling.
+void update_normals(const MoveContext& ctx, const std::vector<std::uint8_t>& on_isosurface,
+                    std::vector<std::uint8_t>& stale, std::vector<Vec3>& normal);
+
 /// Per boundary quad, zero, or for a quad that faces inward an outward reference direction:
 /// a quad faces inward when its normal points against both the isosurface's outward normals
-/// at its corners that lie on the isosurface (`on_isosurface`) and the direction from the
-/// opposite face of its hex to it. Needing both keeps noisy gradients on thin features, and
-/// inverted hexes, from calling a quad turned over on their own.
-std::vector<Vec3> turned_over_quads(const MoveContext& ctx, const std::vector<std::uint8_t>& on_isosurface);
+/// at its corners that lie on the isosurface (`normal`: update_normals()) and the direction
+/// from the opposite face of its hex to it. Needing both keeps noisy gradients on thin
+/// features, and inverted hexes, from calling a quad turned over on their own. Into `turned`.
+void turned_over_quads(const MoveContext& ctx, const std::vector<Vec3>& normal, std::vector<Vec3>& turned);
 
 }  // namespace isohex::surface_detail

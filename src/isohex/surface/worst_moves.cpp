@@ -188,16 +188,22 @@ MoveOutcome raise_worst_quad(const MoveContext& ctx, Index v, double radius, int
   return MoveOutcome::accepted;
 }
 
-std::vector<Vec3> turned_over_quads(const MoveContext& ctx, const std::vector<std::uint8_t>& on_isosurface) {
+void update_normals(const MoveContext& ctx, const std::vector<std::uint8_t>& on_isosurface,
+                    std::vector<std::uint8_t>& stale, std::vector<Vec3>& normal) {
   const auto& g = ctx.graph;
-  const auto& p = ctx.mesh.points;
-  // The field's normal once per vertex (a quad corner would ask four times), then each quad;
-  // every entry is written by one task: the same bits for any thread count.
-  std::vector<Vec3> normal(p.size(), Vec3::Zero());
-  tbb::parallel_for(std::size_t{0}, p.size(), [&](std::size_t v) {
+  normal.resize(ctx.mesh.points.size(), Vec3::Zero());
+  // Every entry is written by one task: the same bits for any thread count.
+  tbb::parallel_for(std::size_t{0}, normal.size(), [&](std::size_t v) {
+    if (!stale[v]) return;
+    stale[v] = 0;
     if (g.on_boundary[v] && on_isosurface[v]) normal[v] = outward_normal(ctx, static_cast<Index>(v));
   });
-  std::vector<Vec3> turned(g.quads.size(), Vec3::Zero());
+}
+
+void turned_over_quads(const MoveContext& ctx, const std::vector<Vec3>& normal, std::vector<Vec3>& turned) {
+  const auto& g = ctx.graph;
+  const auto& p = ctx.mesh.points;
+  turned.assign(g.quads.size(), Vec3::Zero());
   tbb::parallel_for(std::size_t{0}, g.quads.size(), [&](std::size_t i) {
     const Quad& q = g.quads[i];
     const Vec3 n = (p[q[2]] - p[q[0]]).cross(p[q[3]] - p[q[1]]);
@@ -211,7 +217,6 @@ std::vector<Vec3> turned_over_quads(const MoveContext& ctx, const std::vector<st
     const double fl = field.norm(), al = across.norm();
     if (fl > 0 && al > 0) turned[i] = field / fl + across / al;
   });
-  return turned;
 }
 
 }  // namespace isohex::surface_detail
