@@ -5,6 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <random>
 #include <set>
 
 using namespace isohex;
@@ -51,6 +55,62 @@ TEST(Topology, GridCounts) {
   EXPECT_EQ(inc.count(0), 1u);  // a corner of the box
   const Index centre = 1 + (nx + 1) * (1 + (ny + 1) * 1);
   EXPECT_EQ(inc.count(centre), 8u);
+}
+
+// build_quads() and boundary_quads() gather the faces vertex by vertex; their order must be
+// that of a sort of every face's key (sorted vertex ids, then hex × 6 + face), the order the
+// numberings downstream (pillow hexes, surface graphs) are made from. The oracle here sorts
+// every key, on a jittered, renumbered grid with a repeated-vertex (collapsed) hex and a quad
+// shared by three hexes.
+TEST(Topology, QuadsInTheOrderOfTheirSortedKeys) {
+  HexMesh m = grid_mesh(5, 4, 3);
+  std::mt19937 rng(5);
+  std::vector<Index> perm(m.points.size());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), rng);
+  for (Hex& h : m.hexes)
+    for (Index& v : h) v = perm[v];
+  std::vector<Vec3> moved(m.points.size());
+  for (std::size_t v = 0; v < perm.size(); ++v) moved[perm[v]] = m.points[v];
+  m.points = moved;
+  m.hexes.push_back(m.hexes[7]);         // a third hex on each face of hex 7
+  m.hexes[3][6] = m.hexes[3][5];         // a collapsed edge: vertex repeated in one hex
+  struct Key {
+    std::array<Index, 4> key;
+    Index hex_face;
+    bool operator<(const Key& o) const { return key != o.key ? key < o.key : hex_face < o.hex_face; }
+  };
+  std::vector<Key> keys;
+  for (Index h = 0; h < m.num_hexes(); ++h)
+    for (int f = 0; f < 6; ++f) {
+      Key k;
+      for (int c = 0; c < 4; ++c) k.key[c] = m.hexes[h][kHexFaces[f][c]];
+      std::sort(k.key.begin(), k.key.end());
+      k.hex_face = h * 6 + f;
+      keys.push_back(k);
+    }
+  std::sort(keys.begin(), keys.end());
+  std::vector<std::pair<Index, Index>> expected;  // first hex's (hex, face), and the second hex or -1
+  std::vector<Quad> expected_boundary;
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i + 1;
+    while (j < keys.size() && keys[j].key == keys[i].key) ++j;
+    expected.push_back({keys[i].hex_face, j - i > 1 ? keys[i + 1].hex_face / 6 : -1});
+    if (j - i == 1) {
+      const Hex& h = m.hexes[keys[i].hex_face / 6];
+      const auto& f = kHexFaces[keys[i].hex_face % 6];
+      expected_boundary.push_back({h[f[0]], h[f[1]], h[f[2]], h[f[3]]});
+    }
+    i = j;
+  }
+  const auto quads = build_quads(m);
+  ASSERT_EQ(quads.size(), expected.size());
+  for (std::size_t q = 0; q < quads.size(); ++q) {
+    EXPECT_EQ(quads[q].hex[0] * 6 + quads[q].local[0], expected[q].first) << q;
+    EXPECT_EQ(quads[q].hex[1], expected[q].second) << q;
+  }
+  EXPECT_EQ(boundary_quads(m), expected_boundary);
+  EXPECT_EQ(boundary_quads(quads), expected_boundary);
 }
 
 TEST(Topology, BoundaryQuadsPointOutward) {

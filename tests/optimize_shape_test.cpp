@@ -337,6 +337,32 @@ TEST(OptimizeShape, SameBitsForOneAndTwoThreads) {
   for (std::size_t i = 0; i < one.size(); ++i) ASSERT_EQ(one[i], two[i]) << i;
 }
 
+// One incidence shared by the stages (OptimizeOptions' stage options) gives the same mesh as
+// each stage building its own; PointSnapshot holds the free vertices only and puts them back.
+TEST(OptimizeShape, SharedIncidenceAndSnapshotChangeNothing) {
+  HexMesh own = jittered_box(6, 0.7, 11);
+  HexMesh shared = own;
+  PointSnapshot start(own, own.fixed);
+  std::size_t free = 0;
+  for (std::uint8_t f : own.fixed) free += !f;
+  EXPECT_EQ(start.vertices().size(), free);
+  OptimizeOptions o;
+  o.untangle_options.max_iter = 20;
+  optimize_mesh(own, own.fixed, o);
+  const Incidence inc = vertex_hexes(shared);
+  o.untangle_options.incidence = o.shape_options.incidence = o.worst_options.incidence = &inc;
+  optimize_mesh(shared, shared.fixed, o);
+  for (std::size_t v = 0; v < own.points.size(); ++v) ASSERT_EQ(own.points[v], shared.points[v]) << v;
+  // The optimisation moved free vertices only; putting the snapshot back undoes all of it.
+  const HexMesh original = jittered_box(6, 0.7, 11);
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < own.points.size(); ++v) moved += own.points[v] != original.points[v];
+  EXPECT_GT(moved, free / 2);
+  HexMesh back = own;
+  start.restore(back);
+  for (std::size_t v = 0; v < own.points.size(); ++v) ASSERT_EQ(back.points[v], original.points[v]) << v;
+}
+
 // The shape stage's kept ratio bounds (EnergyParams::hex_ratio) are a cache: sweeps with them
 // move every vertex to the same bits as sweeps that recompute each bound, and after the sweeps
 // each kept bound is still the hex's own.

@@ -1,5 +1,6 @@
 #include "isohex/mesh/topology.hpp"
 
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -10,8 +11,7 @@ namespace {
 
 // A face reference sorted by its sorted vertex ids; ties broken by hex * 6 + face (the same
 // order as by hex, then face) so that the order, and hence every numbering derived from it,
-// is unique. 20 bytes: on cthead h 2 (585,000 hexes) the keys are the largest transient of
-// a mesh's topology.
+// is unique.
 struct FaceKey {
   std::array<Index, 4> key;
   Index hex_face;
@@ -27,20 +27,6 @@ Quad face_vertices(const Hex& h, int f) {
   return {h[kHexFaces[f][0]], h[kHexFaces[f][1]], h[kHexFaces[f][2]], h[kHexFaces[f][3]]};
 }
 
-// Every hex face's key, sorted.
-std::vector<FaceKey> sorted_face_keys(const HexMesh& mesh) {
-  std::vector<FaceKey> keys(mesh.hexes.size() * 6);
-  for (std::size_t h = 0; h < mesh.hexes.size(); ++h)
-    for (int f = 0; f < 6; ++f) {
-      FaceKey& k = keys[h * 6 + f];
-      k.key = face_vertices(mesh.hexes[h], f);
-      std::sort(k.key.begin(), k.key.end());
-      k.hex_face = static_cast<Index>(h * 6 + static_cast<std::size_t>(f));
-    }
-  tbb::parallel_sort(keys.begin(), keys.end());
-  return keys;
-}
-
 // Calls f(i, j) for each run keys[i..j) of one face (sorted keys).
 template <class F>
 void for_each_face(const std::vector<FaceKey>& keys, F&& f) {
@@ -52,27 +38,64 @@ void for_each_face(const std::vector<FaceKey>& keys, F&& f) {
   }
 }
 
+// The keys of the faces whose smallest vertex is v, sorted (into `keys`): those of the hexes
+// around v that have v on them.
+void faces_from(const HexMesh& mesh, const Incidence& inc, Index v, std::vector<FaceKey>& keys) {
+  keys.clear();
+  for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) {
+    const Index h = inc.ids[k];
+    if (k > inc.offsets[v] && inc.ids[k - 1] == h) continue;  // v twice in h (listed in hex order)
+    for (int f = 0; f < 6; ++f) {
+      FaceKey fk;
+      fk.key = face_vertices(mesh.hexes[h], f);
+      std::sort(fk.key.begin(), fk.key.end());
+      if (fk.key[0] != v) continue;
+      fk.hex_face = h * 6 + f;
+      keys.push_back(fk);
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+}
+
+// One T per face for which make(keys, i, j, out) returns true (writing it to *out unless out is
+// null), in the order of a sort of every hex face's key (the faces of smallest vertex v come
+// before those of v + 1), without holding every key: on cthead h 2 those were 70 MB, the peak
+// of the pillow stage's validation. Blocks of vertices in parallel: a first pass counts, a
+// second writes each block's faces at its offset (the same output for any thread count).
+template <class T, class Make>
+std::vector<T> collect_faces(const HexMesh& mesh, Make&& make) {
+  const Incidence inc = vertex_hexes(mesh);
+  const std::size_t nv = mesh.points.size(), block = 4096, blocks = (nv + block - 1) / block;
+  const auto scan = [&](std::size_t b, T* out) {
+    thread_local std::vector<FaceKey> keys;
+    std::size_t n = 0;
+    for (std::size_t v = b * block; v < std::min(nv, (b + 1) * block); ++v) {
+      faces_from(mesh, inc, static_cast<Index>(v), keys);
+      for_each_face(keys, [&](std::size_t i, std::size_t j) { n += make(keys, i, j, out ? out + n : nullptr); });
+    }
+    return n;
+  };
+  std::vector<std::size_t> offset(blocks + 1, 0);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) { offset[b + 1] = scan(b, nullptr); });
+  for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
+  std::vector<T> out(offset.back());
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) { scan(b, out.data() + offset[b]); });
+  return out;
+}
+
 }  // namespace
 
 std::vector<QuadFace> build_quads(const HexMesh& mesh) {
-  const std::vector<FaceKey> keys = sorted_face_keys(mesh);
-  // Exactly as many as there are: a guess that falls short makes the vector grow to twice
-  // its size with the old one still held (cthead h 2: 140 MB at validate()'s peak instead of 47).
-  std::size_t unique = 0;
-  for_each_face(keys, [&](std::size_t, std::size_t) { ++unique; });
-  std::vector<QuadFace> quads;
-  quads.reserve(unique);
-  for_each_face(keys, [&](std::size_t i, std::size_t j) {
-    QuadFace q;
-    q.vertices = face_vertices(mesh.hexes[keys[i].hex()], keys[i].face());
-    q.hex[0] = keys[i].hex();
-    q.local[0] = static_cast<std::int8_t>(keys[i].face());
-    q.hex[1] = j - i > 1 ? keys[i + 1].hex() : -1;
-    q.local[1] = static_cast<std::int8_t>(j - i > 1 ? keys[i + 1].face() : -1);
-    q.extra_hexes = static_cast<Index>(j - i > 2 ? j - i - 2 : 0);
-    quads.push_back(q);
+  return collect_faces<QuadFace>(mesh, [&](const std::vector<FaceKey>& keys, std::size_t i, std::size_t j, QuadFace* q) {
+    if (!q) return true;
+    q->vertices = face_vertices(mesh.hexes[keys[i].hex()], keys[i].face());
+    q->hex[0] = keys[i].hex();
+    q->local[0] = static_cast<std::int8_t>(keys[i].face());
+    q->hex[1] = j - i > 1 ? keys[i + 1].hex() : -1;
+    q->local[1] = static_cast<std::int8_t>(j - i > 1 ? keys[i + 1].face() : -1);
+    q->extra_hexes = static_cast<Index>(j - i > 2 ? j - i - 2 : 0);
+    return true;
   });
-  return quads;
 }
 
 std::vector<Quad> boundary_quads(const std::vector<QuadFace>& quads) {
@@ -84,12 +107,11 @@ std::vector<Quad> boundary_quads(const std::vector<QuadFace>& quads) {
 
 // The quads used by one hex, in build_quads()'s order, without its vector of every quad.
 std::vector<Quad> boundary_quads(const HexMesh& mesh) {
-  const std::vector<FaceKey> keys = sorted_face_keys(mesh);
-  std::vector<Quad> out;
-  for_each_face(keys, [&](std::size_t i, std::size_t j) {
-    if (j - i == 1) out.push_back(face_vertices(mesh.hexes[keys[i].hex()], keys[i].face()));
+  return collect_faces<Quad>(mesh, [&](const std::vector<FaceKey>& keys, std::size_t i, std::size_t j, Quad* q) {
+    if (j - i != 1) return false;
+    if (q) *q = face_vertices(mesh.hexes[keys[i].hex()], keys[i].face());
+    return true;
   });
-  return out;
 }
 
 std::vector<std::array<Index, 2>> build_edges(const HexMesh& mesh) {
