@@ -345,7 +345,7 @@ TEST(OptimizeShape, SharedIncidenceAndSnapshotChangeNothing) {
   PointSnapshot start(own, own.fixed);
   std::size_t free = 0;
   for (std::uint8_t f : own.fixed) free += !f;
-  EXPECT_EQ(start.vertices().size(), free);
+  EXPECT_GE(start.held(), free);
   OptimizeOptions o;
   o.untangle_options.max_iter = 20;
   optimize_mesh(own, own.fixed, o);

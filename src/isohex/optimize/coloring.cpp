@@ -46,15 +46,25 @@ VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_
 PointSnapshot::PointSnapshot(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed) {
   for (Index v = 0; v < mesh.num_vertices(); ++v)
     if (fixed.empty() || !fixed[v]) ids_.push_back(v);
-  at_.resize(ids_.size());
+  if (ids_.size() * (sizeof(Index) + sizeof(Vec3)) >= mesh.points.size() * sizeof(Vec3))
+    std::vector<Index>().swap(ids_);  // every point: cheaper than ids and places
+  at_.resize(ids_.empty() ? mesh.points.size() : ids_.size());
   take(mesh);
 }
 
 void PointSnapshot::take(const HexMesh& mesh) {
+  if (ids_.empty()) {
+    std::copy(mesh.points.begin(), mesh.points.end(), at_.begin());
+    return;
+  }
   for (std::size_t i = 0; i < ids_.size(); ++i) at_[i] = mesh.points[ids_[i]];
 }
 
 void PointSnapshot::restore(HexMesh& mesh) const {
+  if (ids_.empty()) {
+    std::copy(at_.begin(), at_.end(), mesh.points.begin());
+    return;
+  }
   for (std::size_t i = 0; i < ids_.size(); ++i) mesh.points[ids_[i]] = at_[i];
 }
 

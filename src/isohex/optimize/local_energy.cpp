@@ -495,7 +495,7 @@ double total_energy(const HexMesh& mesh, const std::vector<double>& inv_len, con
 }
 
 double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc, const std::vector<double>& inv_len,
-             const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps) {
+             const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps, MoveRecord* record) {
   double max_grad = 0;
   std::vector<double> grad;
   for (const std::vector<Index>& color : coloring.colors) {
@@ -506,11 +506,16 @@ double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const Index v = color[i];
         if (!frozen.empty() && frozen[v]) continue;
+        const Vec3 x0 = mesh.points[v];
         for (int s = 0; s < steps; ++s) {
           const Move m = newton_move(mesh, inc, inv_len, v, params);
           if (s == 0) grad[i] = m.grad;
           if (!m.moved) break;
           mesh.points[v] = m.x;
+        }
+        if (record && mesh.points[v] != x0) {
+          const std::uint8_t far = (mesh.points[v] - x0).norm() > record->cull * (*record->scale)[v] ? 2 : 1;
+          record->moved[v] = std::max(record->moved[v], far);
         }
       }
     });
@@ -543,16 +548,13 @@ void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& o
   });
 }
 
-void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const PointSnapshot& before,
-                    const std::vector<double>& scale, double cull, std::vector<std::uint8_t>& near,
+void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const MoveRecord& record, std::vector<std::uint8_t>& near,
                     std::vector<std::uint8_t>* changed) {
-  for (std::size_t k = 0; k < before.vertices().size(); ++k) {
-    const Index v = before.vertices()[k];
-    if (mesh.points[v] == before.place(k)) continue;
-    const bool far = (mesh.points[v] - before.place(k)).norm() > cull * scale[v];
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (record.moved[v] == 0) continue;
     for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
       if (changed) (*changed)[inc.ids[i]] = 1;
-      if (far)
+      if (record.moved[v] == 2)
         for (Index w : mesh.hexes[inc.ids[i]]) near[w] = 1;
     }
   }

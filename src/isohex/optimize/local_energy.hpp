@@ -207,8 +207,17 @@ double energy_sum(const std::vector<double>& e);
 /// One Gauss–Seidel sweep: colours in order, the vertices of a colour in parallel, each taking
 /// `steps` Newton moves. Vertices with frozen[v] set do not move (frozen may be empty).
 /// Returns the largest scaled gradient norm seen.
+/// Culling's record of sweeps (sweep()'s `record`): per vertex the largest, over the sweeps
+/// since `moved` was cleared, of 0 (did not move), 1 (moved) and 2 (moved more than cull ×
+/// scale[v] in one sweep). Written as the sweep moves each vertex: no copy of the points.
+struct MoveRecord {
+  const std::vector<double>* scale = nullptr;
+  double cull = 0;
+  std::vector<std::uint8_t> moved;
+};
 double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc, const std::vector<double>& inv_len,
-             const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps = 1);
+             const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps = 1,
+             MoveRecord* record = nullptr);
 
 /// Minimum certified scaled Jacobian (certified_scaled_jacobian(): Verdict's, 0 for a hex not
 /// certified valid inside; degenerate counts as -1) and the number of hexes <= 0.
@@ -223,10 +232,9 @@ SJStats sj_stats_of(const std::vector<double>& sj, const std::vector<std::uint8_
 /// certified_scaled_jacobian() of the hexes flagged in `only`, into sj (parallel).
 void update_certified_sj(const HexMesh& mesh, const std::vector<std::uint8_t>& only, std::vector<double>& sj);
 /// Culling, shared by the untangler and the shape stage: flags in `near` the vertices of the hexes
-/// around each vertex that moved more than cull × scale[v] from its place in `before`; with
-/// `changed`, the hexes around every vertex that moved at all. Neither is cleared first.
-void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const PointSnapshot& before,
-                    const std::vector<double>& scale, double cull, std::vector<std::uint8_t>& near,
+/// around each vertex that `record` saw move farther than its cull; with `changed`, the hexes
+/// around every vertex that moved at all. Neither is cleared first.
+void mark_far_moves(const HexMesh& mesh, const Incidence& inc, const MoveRecord& record, std::vector<std::uint8_t>& near,
                     std::vector<std::uint8_t>* changed = nullptr);
 
 /// The caller's incidence if it gave one (it must be vertex_hexes(mesh)), else one built into

@@ -83,19 +83,20 @@ struct VertexColoring {
 VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
                               const Incidence* inc = nullptr);
 
-/// The places of the vertices an optimisation may move (those not flagged in `fixed`), to
-/// compare with or go back to: a copy of those alone. A band round holds all but a few thousand of cthead h
-/// 2's 630,000 vertices, and whole copies of the points were 15 MB each.
+/// The places of the vertices an optimisation may move (those not flagged in `fixed`), to go
+/// back to: a copy of those alone, or of every point where nearly all are free (an id and a
+/// place cost more than a place). A band round holds all but a few thousand of cthead h 2's
+/// 634,000 vertices, and whole copies of the points were 15 MB each.
 class PointSnapshot {
  public:
   PointSnapshot(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed);
   void take(const HexMesh& mesh);     ///< the places now
   void restore(HexMesh& mesh) const;  ///< back to the places taken
-  const std::vector<Index>& vertices() const { return ids_; }  ///< ascending
-  const Vec3& place(std::size_t i) const { return at_[i]; }     ///< of vertices()[i]
+  /// How many vertices' places it holds (at least the free ones).
+  std::size_t held() const { return at_.size(); }
 
  private:
-  std::vector<Index> ids_;
+  std::vector<Index> ids_;  ///< ascending; empty when every point is held
   std::vector<Vec3> at_;
 };
 

@@ -72,17 +72,17 @@ ShapeResult optimize_shape(HexMesh& mesh, const std::vector<std::uint8_t>& fixed
   for (Index v = 0; v < mesh.num_vertices(); ++v) scale[v] = opt::vertex_length(inc, inv_len, v);
   const double cull = options.cull;
   std::vector<std::uint8_t> held = frozen, changed(mesh.hexes.size(), 0), active(mesh.points.size());
-  PointSnapshot before(mesh, fixed);
+  opt::MoveRecord record{&scale, cull, std::vector<std::uint8_t>(mesh.points.size(), 0)};
   for (int it = 1; it <= options.max_iter; ++it) {
     opt::EnergyParams params;
     params.surface = options.surface;
     params.rank_guard = options.rank_guard;
     params.hex_ratio = keep_ratios ? &ratio : nullptr;
-    before.take(mesh);
-    const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, held, 1);
+    std::fill(record.moved.begin(), record.moved.end(), 0);
+    const double grad = opt::sweep(mesh, coloring, inc, inv_len, params, held, 1, &record);
     std::fill(changed.begin(), changed.end(), 0);
     std::fill(active.begin(), active.end(), 0);
-    opt::mark_far_moves(mesh, inc, before, scale, cull, active, &changed);
+    opt::mark_far_moves(mesh, inc, record, active, &changed);
     res.culled = 0;
     if (cull > 0)
       for (Index v = 0; v < mesh.num_vertices(); ++v) {

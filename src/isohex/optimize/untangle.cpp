@@ -187,7 +187,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
   for (std::size_t v = 0; v < scale.size(); ++v) scale[v] = opt::vertex_length(inc, inv_len, static_cast<Index>(v));
   std::vector<std::uint8_t> near(mesh.points.size());
   bool culling = false;  // `near` holds the last sweep's far moves
-  PointSnapshot before(mesh, cull > 0 ? fixed : std::vector<std::uint8_t>(mesh.points.size(), 1));
+  opt::MoveRecord record{&scale, cull, std::vector<std::uint8_t>(cull > 0 ? mesh.points.size() : 0)};
   for (int it = 1; it <= options.max_iter; ++it) {
     for (std::size_t h = 0; h < sj.size(); ++h) {
       const std::uint8_t b = sj[h] <= 0 || is_degenerate(sj[h]);
@@ -207,13 +207,14 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     const std::vector<std::uint8_t> touched = touched_hexes(mesh, frozen);
     opt::hex_energies(mesh, inv_len, params, energy_skip, hex_e, &touched);  // at this ε
     const double e_before = sum_over(touched);
-    if (cull > 0) before.take(mesh);
-    for (int s = 0; s < options.sweeps; ++s) opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2);
+    std::fill(record.moved.begin(), record.moved.end(), 0);
+    for (int s = 0; s < options.sweeps; ++s)
+      opt::sweep(mesh, coloring, inc, inv_len, params, frozen, 2, cull > 0 ? &record : nullptr);
     res.vertex_sweeps += static_cast<std::size_t>(options.sweeps) *
                          static_cast<std::size_t>(std::count(frozen.begin(), frozen.end(), std::uint8_t{0}));
     if (cull > 0) {
       std::fill(near.begin(), near.end(), 0);
-      opt::mark_far_moves(mesh, inc, before, scale, cull, near);
+      opt::mark_far_moves(mesh, inc, record, near);
       culling = true;
     }
     opt::hex_energies(mesh, inv_len, params, energy_skip, hex_e, &touched);
