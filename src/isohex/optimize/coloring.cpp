@@ -1,5 +1,7 @@
-// Fixed-vertex masks, snapshots of the free vertices and the vertex colouring behind the parallel Gauss–Seidel sweeps.
+// Fixed-vertex masks, snapshots of the free vertices, and the vertex colouring behind the
+// parallel Gauss–Seidel sweeps.
 #include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 
 #include <algorithm>
@@ -21,7 +23,7 @@ std::vector<std::uint8_t> fixed_mask(const HexMesh& mesh, FixedVertices which) {
 
 VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const Incidence* given) {
   Incidence own;
-  const Incidence& inc = given ? *given : (own = vertex_hexes(mesh));
+  const Incidence& inc = opt::incidence_of(mesh, given, own);
   std::vector<int> color(mesh.points.size(), -1);
   std::vector<Index> stamp;  // stamp[c] == v: colour c is taken by a neighbour of v
   VertexColoring out;

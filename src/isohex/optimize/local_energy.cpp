@@ -361,14 +361,7 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     for (int t = 0; t < frames; ++t) {
       const CoefKind kind = kKinds[t][k];
       if (kind == CoefKind::zero) continue;  // frame t does not see vertex v: its term is a constant
-      if (t < 8) {
-        Mat3 A;
-        const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
-        for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * il;  // frame()'s arithmetic
-        if (!visit(A, t, kind)) return kInf;
-      } else if (!visit(frame(p, t, il), t, kind)) {
-        return kInf;
-      }
+      if (!(t < 8 ? visit(corner_frame(p, t, il), t, kind) : visit(frame(p, t, il), t, kind))) return kInf;
     }
     if (params.bernstein_of(h)) {
       e += bernstein_energy(p, k, il, params, eps, g, H);

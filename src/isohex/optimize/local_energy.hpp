@@ -116,12 +116,18 @@ Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
 /// Frame t of corners p (already the hex's corners), scaled by inv_len. Inline: out of line,
 /// its result went through memory as scalar stores read back as vector loads, a stall at every
 /// frame of the energies' innermost loops (a tenth of vertex_energy()'s samples on cthead h 2).
-[[gnu::always_inline]] inline Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+/// Corner frame t < 8 of corners p, scaled by inv_len (frame()).
+[[gnu::always_inline]] inline Mat3 corner_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   Mat3 A;
-  if (t < 8) {
-    const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
-    for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
-  } else if (t == kCentreFrame) {
+  const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
+  for (int j = 0; j < 3; ++j) A.col(j) = (p[nb[j]] - p[t]) * inv_len;
+  return A;
+}
+
+[[gnu::always_inline]] inline Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+  if (t < 8) return corner_frame(p, t, inv_len);
+  Mat3 A;
+  if (t == kCentreFrame) {
     A.col(0) = ((p[1] - p[0]) + (p[2] - p[3]) + (p[5] - p[4]) + (p[6] - p[7])) * (0.25 * inv_len);
     A.col(1) = ((p[3] - p[0]) + (p[2] - p[1]) + (p[7] - p[4]) + (p[6] - p[5])) * (0.25 * inv_len);
     A.col(2) = ((p[4] - p[0]) + (p[5] - p[1]) + (p[6] - p[2]) + (p[7] - p[3])) * (0.25 * inv_len);
@@ -204,9 +210,6 @@ void hex_energies(const HexMesh& mesh, const std::vector<double>& inv_len, const
                   const std::vector<std::uint8_t>* only = nullptr);
 double energy_sum(const std::vector<double>& e);
 
-/// One Gauss–Seidel sweep: colours in order, the vertices of a colour in parallel, each taking
-/// `steps` Newton moves. Vertices with frozen[v] set do not move (frozen may be empty).
-/// Returns the largest scaled gradient norm seen.
 /// Culling's record of sweeps (sweep()'s `record`): per vertex the largest, over the sweeps
 /// since `moved` was cleared, of 0 (did not move), 1 (moved) and 2 (moved more than cull ×
 /// scale[v] in one sweep). Written as the sweep moves each vertex: no copy of the points.
@@ -215,6 +218,9 @@ struct MoveRecord {
   double cull = 0;
   std::vector<std::uint8_t> moved;
 };
+/// One Gauss–Seidel sweep: colours in order, the vertices of a colour in parallel, each taking
+/// `steps` Newton moves. Vertices with frozen[v] set do not move (frozen may be empty); with
+/// `record`, each move is recorded there. Returns the largest scaled gradient norm seen.
 double sweep(HexMesh& mesh, const VertexColoring& coloring, const Incidence& inc, const std::vector<double>& inv_len,
              const EnergyParams& params, const std::vector<std::uint8_t>& frozen, int steps = 1,
              MoveRecord* record = nullptr);
