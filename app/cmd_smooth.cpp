@@ -234,7 +234,7 @@ void register_smooth(CLI::App& app) {
   cmd->add_option("--max-iter", a->max_iter,
                   "Iteration limit of the untangler and the shape stage (default 200 and 100; the untangler "
                   "usually stops earlier, when it stalls)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--tol", a->tol, "Stop the shape stage below this relative improvement per sweep (default 1e-4)")
+  cmd->add_option("--tol", a->tol, "Stop the shape stage below this relative improvement per sweep (default 5e-4)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--cull", a->cull,
                   "Untangling and shape stage: a sweep moves only the vertices near one that moved more than this "

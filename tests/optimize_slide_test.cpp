@@ -616,6 +616,34 @@ TEST(OptimizeSlide, BandClampAndReleasedRims) {
   EXPECT_LE(surface.offset(rim, x), 0.1 * (1 + 1e-6));
 }
 
+// An isosurface goes on past the domain's faces: a sliding vertex's step whose foot on it lies
+// beyond the box is refused (the vertex stays), one whose foot is inside is taken.
+TEST(OptimizeSlide, FeetOutsideTheDomainAreRefused) {
+  const Volume volume = distance_volume(41);
+  const IsoField field(volume, 1.0, Inside::below);
+  HexMesh in = distorted_iso_ball(field);
+  BoundarySurface surface(in, field, 30.0);
+  Index v = -1;
+  for (Index w = 0; w < in.num_vertices() && v < 0; ++w)
+    if (surface.role(w) == BoundarySurface::Role::slides && in.points[w].z() > 0.3 && in.points[w].z() < 0.7) v = w;
+  ASSERT_GE(v, 0);
+  const double top = in.points[v].z() + 0.05;
+  surface.set_domain(Aabb{Vec3::Constant(-1.5), Vec3(1.5, 1.5, top)});
+  EXPECT_TRUE(surface.in_domain(in.points[v]));
+  Vec3 n;
+  ASSERT_TRUE(surface.tangent_normal(v, in.points[v], n));
+  const Vec3 up = (Vec3::UnitZ() - n * n.z()).normalized();
+  Vec3 x = in.points[v] + 0.3 * up;  // its foot about 0.2 higher: above the box
+  const Vec3 step = x;
+  EXPECT_FALSE(surface.put_back(v, x, n, 0.5));
+  EXPECT_EQ(x, step);
+  x = in.points[v] - 0.1 * up;
+  ASSERT_TRUE(surface.put_back(v, x, n, 0.5));
+  EXPECT_LE(x.z(), top);
+  EXPECT_NEAR(x.norm(), 1.0, 2e-2);
+  EXPECT_NEAR(field.value(x), 1.0, 1e-6);  // on the isosurface
+}
+
 // The band on an input's own boundary (`isohex smooth --boundary slide --surface-band 0.3`) on
 // the ECR dragon, which sliding alone leaves with 38 inverted hexes (22 of them proven so with
 // its feature vertices pinned): released, feature vertices included, every hex reaches 0.2

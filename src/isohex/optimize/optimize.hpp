@@ -233,7 +233,7 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
 /// Options of the shape optimiser.
 struct ShapeOptions {
   int max_iter = 100;        ///< Gauss–Seidel sweeps
-  double tol = 1e-4;         ///< stop when a sweep lowers the objective by less than tol (relative) ...
+  double tol = 5e-4;         ///< stop when a sweep lowers the objective by less than tol (relative) ...
   double min_sj_gain = 1e-3; ///< ... and raises the smallest certified scaled Jacobian by less than this
   double grad_tol = 1e-8;    ///< ... or when the largest vertex gradient (× edge length) is below this
   /// Culling: a sweep moves only the vertices of the hexes around a vertex that moved more

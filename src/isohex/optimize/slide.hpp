@@ -87,8 +87,12 @@ class BoundarySurface {
   /// for vertices loosen() released from sliding (false, and nothing changes, for the others:
   /// a pinned vertex's place is not any point of one surface).
   bool reattach(Index v);
-  /// The box loose vertices must stay in (the domain: a band must not carry them out of it).
+  /// The box the moving boundary vertices must stay in (the domain: neither a band nor an
+  /// isosurface that goes on past its faces may carry them out of it).
   void set_domain(const Aabb& box) { domain_ = box; has_domain_ = true; }
+  /// x within the domain box (1e-9 of its diagonal spare), or no box set. Steps that would put
+  /// a vertex on its surface outside it are refused.
+  [[nodiscard]] bool in_domain(const Vec3& x) const;
   /// Puts x, a step of loose vertex v (local edge length `len`), back within the band: into the
   /// domain box if one is set, then x's foot point on v's target (the level set's projection,
   /// or the nearest triangle point) and, if x is farther than the band from it, the point at

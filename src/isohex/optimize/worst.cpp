@@ -16,6 +16,9 @@
 #include <limits>
 #include <numeric>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace isohex {
 
 namespace {
@@ -309,7 +312,9 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     sj[h] = is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian;
     rank[h] = opt::hex_rank(c);
   };
-  for (Index h = 0; h < mesh.num_hexes(); ++h) update(h);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, mesh.num_hexes(), 1024), [&](const tbb::blocked_range<Index>& r) {
+    for (Index h = r.begin(); h != r.end(); ++h) update(h);  // each hex its own entries
+  });
   const auto mesh_min = [&] { return sj.empty() ? 1.0 : *std::min_element(sj.begin(), sj.end()); };
   res.min_sj_before = res.min_sj_after = mesh_min();
   std::vector<Index> order;
