@@ -48,14 +48,14 @@ VertexColoring color_vertices(const HexMesh& mesh, const std::vector<std::uint8_
 PointSnapshot::PointSnapshot(const HexMesh& mesh, const std::vector<std::uint8_t>& fixed) {
   for (Index v = 0; v < mesh.num_vertices(); ++v)
     if (fixed.empty() || !fixed[v]) ids_.push_back(v);
-  if (ids_.size() * (sizeof(Index) + sizeof(Vec3)) >= mesh.points.size() * sizeof(Vec3))
-    std::vector<Index>().swap(ids_);  // every point: cheaper than ids and places
-  at_.resize(ids_.empty() ? mesh.points.size() : ids_.size());
+  whole_ = ids_.size() * (sizeof(Index) + sizeof(Vec3)) >= mesh.points.size() * sizeof(Vec3);
+  if (whole_) std::vector<Index>().swap(ids_);  // every point: cheaper than ids and places
+  at_.resize(whole_ ? mesh.points.size() : ids_.size());
   take(mesh);
 }
 
 void PointSnapshot::take(const HexMesh& mesh) {
-  if (ids_.empty()) {
+  if (whole_) {
     std::copy(mesh.points.begin(), mesh.points.end(), at_.begin());
     return;
   }
@@ -63,7 +63,7 @@ void PointSnapshot::take(const HexMesh& mesh) {
 }
 
 void PointSnapshot::restore(HexMesh& mesh) const {
-  if (ids_.empty()) {
+  if (whole_) {
     std::copy(at_.begin(), at_.end(), mesh.points.begin());
     return;
   }

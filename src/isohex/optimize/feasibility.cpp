@@ -1,6 +1,8 @@
 // Affine frame determinants around one vertex and the 4-unknown LP that maximises their minimum.
 #include "isohex/optimize/feasibility.hpp"
 
+#include "isohex/internal/multiversion.hpp"
+
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/quality/jacobian_bounds.hpp"
 
@@ -10,12 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define ISOHEX_HAVE_FMV 1
-#else
-#define ISOHEX_HAVE_FMV 0
-#endif
 
 namespace isohex::opt {
 

@@ -361,6 +361,8 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     for (int t = 0; t < frames; ++t) {
       const CoefKind kind = kKinds[t][k];
       if (kind == CoefKind::zero) continue;  // frame t does not see vertex v: its term is a constant
+      // Each branch builds the matrix it visits: one matrix merged from both at a join went
+      // through memory again (the stall frame() is inline to avoid).
       if (!(t < 8 ? visit(corner_frame(p, t, il), t, kind) : visit(frame(p, t, il), t, kind))) return kInf;
     }
     if (params.bernstein_of(h)) {

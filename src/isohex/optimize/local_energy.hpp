@@ -113,9 +113,6 @@ std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
 /// Frame t >= kFrames (an interior one) of corners p, scaled by inv_len (frame()).
 Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
 
-/// Frame t of corners p (already the hex's corners), scaled by inv_len. Inline: out of line,
-/// its result went through memory as scalar stores read back as vector loads, a stall at every
-/// frame of the energies' innermost loops (a tenth of vertex_energy()'s samples on cthead h 2).
 /// Corner frame t < 8 of corners p, scaled by inv_len (frame()).
 [[gnu::always_inline]] inline Mat3 corner_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   Mat3 A;
@@ -124,6 +121,9 @@ Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
   return A;
 }
 
+/// Frame t of corners p (already the hex's corners), scaled by inv_len. Inline: out of line,
+/// its result went through memory as scalar stores read back as vector loads, a stall at every
+/// frame of the energies' innermost loops (a tenth of vertex_energy()'s samples on cthead h 2).
 [[gnu::always_inline]] inline Mat3 frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   if (t < 8) return corner_frame(p, t, inv_len);
   Mat3 A;

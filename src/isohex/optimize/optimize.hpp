@@ -96,7 +96,8 @@ class PointSnapshot {
   std::size_t held() const { return at_.size(); }
 
  private:
-  std::vector<Index> ids_;  ///< ascending; empty when every point is held
+  bool whole_ = false;      ///< every point is held (at_[v] is vertex v's place)
+  std::vector<Index> ids_;  ///< else the held vertices, ascending (at_[i] is ids_[i]'s place)
   std::vector<Vec3> at_;
 };
 

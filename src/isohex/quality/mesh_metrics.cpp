@@ -11,6 +11,7 @@
 
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/verdict_vector.hpp"
+#include "isohex/internal/multiversion.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -18,11 +19,8 @@
 #include <cmath>
 #include <cstddef>
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define ISOHEX_HAVE_FMV 1
+#if ISOHEX_HAVE_FMV
 #include <immintrin.h>
-#else
-#define ISOHEX_HAVE_FMV 0
 #endif
 
 namespace isohex {
