@@ -206,6 +206,34 @@ TEST(JacobianBounds, LatticeAndCombinedTestAgreeExactly) {
   EXPECT_GT(invalid, 10u);
 }
 
+// The coefficients come from a vectorised kernel (27 triple products side by side); they must
+// be the very bits of det J sampled one point at a time (Eigen's cross and dot) on the lattice
+// and converted: the whole element and sub-boxes, near and far from the origin.
+TEST(JacobianBounds, CoefficientsAreThoseOfTheSampledLatticeBitForBit) {
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> t(0, 1);
+  for (int trial = 0; trial < 300; ++trial) {
+    Corners p = jittered(rng, trial % 3 == 0 ? 0.45 : 0.2);
+    if (trial % 2) for (Vec3& x : p) x = 1e3 * x + Vec3(-7e4, 3e3, 1e5);
+    const bool whole = trial % 4 < 2;
+    const Vec3 lo = whole ? Vec3::Zero() : Vec3(0.5 * t(rng), 0.5 * t(rng), 0.5 * t(rng));
+    const Vec3 hi = whole ? Vec3::Ones() : Vec3(0.5 + 0.5 * t(rng), 0.5 + 0.5 * t(rng), 1);
+    std::array<double, 27> ref;
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) {
+          const Vec3 m = 0.5 * (lo + hi);
+          const double u = i == 0 ? lo[0] : i == 1 ? m[0] : hi[0];
+          const double v = j == 0 ? lo[1] : j == 1 ? m[1] : hi[1];
+          const double w = k == 0 ? lo[2] : k == 1 ? m[2] : hi[2];
+          ref[i + 3 * j + 9 * k] = jacobian_determinant(p, u, v, w);
+        }
+    lattice_to_bernstein(ref);
+    const std::array<double, 27> b = whole ? jacobian_bernstein(p) : jacobian_bernstein(p, lo, hi);
+    for (int n = 0; n < 27; ++n) EXPECT_EQ(b[n], ref[n]) << trial << " coefficient " << n;
+  }
+}
+
 TEST(VolumeBalance, BoxMatchesAndAFoldIsSeen) {
   HexMesh box = box_mesh(4, 3, 2, Vec3::Zero(), Vec3(2, 3, 1));
   VolumeBalance v = volume_balance(box);

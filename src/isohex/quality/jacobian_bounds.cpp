@@ -4,6 +4,7 @@
 
 #include "isohex/mesh/topology.hpp"
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/internal/multiversion.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -61,6 +62,53 @@ void unit_lattice(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, st
   x[5] = 0.5 * b + 0.5 * d;
 }
 
+// det J at the 27 lattice points, b[i + 3j + 9k] = xu[j + 3k] · (xv[i + 3k] × xw[i + 3j]):
+// the operands laid out side by side first (structure of arrays), so that the compiler packs
+// the 27 triple products into SIMD instructions; each is Eigen's cross then dot, the same
+// operations in the same order, so the same bits (tested). Two and a half times faster than
+// the loop over Vec3s, and the certificates (every shape step's, every worst-pass trial's) are
+// most of their callers' time.
+[[gnu::always_inline]] inline void lattice_dets_body(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv,
+                                                     const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
+  alignas(64) double U[3][28], V[3][28], W[3][28], b[28];
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        const int n = i + 3 * j + 9 * k;
+        for (int c = 0; c < 3; ++c) {
+          U[c][n] = xu[j + 3 * k][c];
+          V[c][n] = xv[i + 3 * k][c];
+          W[c][n] = xw[i + 3 * j][c];
+        }
+      }
+  for (int c = 0; c < 3; ++c) U[c][27] = V[c][27] = W[c][27] = 0;  // a 28th lane: whole vectors
+  for (int n = 0; n < 28; ++n) {
+    const double cx = V[1][n] * W[2][n] - V[2][n] * W[1][n];
+    const double cy = V[2][n] * W[0][n] - V[0][n] * W[2][n];
+    const double cz = V[0][n] * W[1][n] - V[1][n] * W[0][n];
+    b[n] = U[0][n] * cx + U[1][n] * cy + U[2][n] * cz;
+  }
+  for (int n = 0; n < 27; ++n) out[n] = b[n];
+}
+
+#if ISOHEX_HAVE_FMV
+// AVX2 where the CPU has it (no FMA: the library builds with -ffp-contract=off); AVX-512 was
+// no faster on 28 lanes.
+[[gnu::target("default")]] void lattice_dets(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv,
+                                             const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
+  lattice_dets_body(xu, xv, xw, out);
+}
+[[gnu::target("avx2")]] void lattice_dets(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv,
+                                          const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
+  lattice_dets_body(xu, xv, xw, out);
+}
+#else
+void lattice_dets(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv, const std::array<Vec3, 9>& xw,
+                  std::array<double, 27>& out) {
+  lattice_dets_body(xu, xv, xw, out);
+}
+#endif
+
 // The 27 samples on the lattice of [lo, hi] and their Bernstein coefficients; `samples`
 // (values actually taken by det J) may be null. (The same values as det_at() at each point,
 // bit for bit: its edge vectors, each computed once.)
@@ -87,9 +135,7 @@ std::array<double, 27> bernstein_box(const std::array<Vec3, 8>& q, const Vec3& l
         xw[a + 3 * b2] = edge_w(q, us[a], vs[b2]);
       }
   }
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) b[i + 3 * j + 9 * k] = xu[j + 3 * k].dot(xv[i + 3 * k].cross(xw[i + 3 * j]));
+  lattice_dets(xu, xv, xw, b);
   if (samples) *samples = b;
   lattice_to_bernstein(b);
   return b;
