@@ -58,6 +58,7 @@ struct Args {
   /// unset: slide unless --no-smooth.
   std::optional<bool> slide;
   int surface_iterations = 100;
+  int surface_stall = 20;
   std::optional<double> refine_tolerance;  ///< --refine-boundary TOL
   int refine_levels = 1;
   std::optional<double> feature_angle;
@@ -94,10 +95,11 @@ Volume sample_shape(const Args& a, double& cell_size) {
 
 // Smooths the boundary on each isosurface of the region in turn (smooth_region_surfaces).
 std::vector<SurfaceSmoothingReport> smooth_surfaces(const contour::Region& region, contour::ExtractResult& out,
-                                                    int iterations, double feature_angle, bool guard_hexes,
+                                                    int iterations, int stall, double feature_angle, bool guard_hexes,
                                                     bool terminal) {
   SurfaceSmoothingOptions opt;
   opt.iterations = iterations;
+  opt.stall_iterations = stall;
   opt.guard_hexes = guard_hexes;
   opt.field_crease_angle_degrees = feature_angle;
   if (!guard_hexes) opt.interior_layers = 0;  // the hexes below are re-shaped after pillowing
@@ -110,7 +112,7 @@ void print_smoothing(const contour::LevelSet& surface, const SurfaceSmoothingRep
   if (!surface.field()) return;
   fmt::print("surface smoothing on {}: {} iterations{}; boundary quad SJ min {:.4g} -> {:.4g}, mean {:.4g} -> {:.4g}, "
              "< {}: {} -> {}; fans < {}: {} -> {}; hexes inverted {} -> {}; max-min: {} passes, {} moves\n",
-             surface.describe(), s.iterations, s.converged ? " (converged)" : "", s.before.quad_sj_min,
+             surface.describe(), s.iterations, s.converged ? " (converged)" : s.stalled ? " (stalled)" : "", s.before.quad_sj_min,
              s.after.quad_sj_min, s.before.quad_sj_mean, s.after.quad_sj_mean, kQuestionableSJ, s.before.quads_below,
              s.after.quads_below, kQuestionableSJ, s.before.fans_below, s.after.fans_below, s.before.hexes_inverted,
              s.after.hexes_inverted, s.worst_passes, s.worst_moves);
@@ -124,7 +126,7 @@ nlohmann::json smoothing_json(const contour::LevelSet& surface, const SurfaceSmo
                           {"hexes_inverted", x.hexes_inverted}};
   };
   return {{"surface", surface.describe()}, {"smoothed", surface.field() != nullptr}, {"iterations", s.iterations},
-          {"converged", s.converged}, {"before", q(s.before)}, {"after", q(s.after)},
+          {"converged", s.converged}, {"stalled", s.stalled}, {"before", q(s.before)}, {"after", q(s.after)},
           {"max_level_relative", s.max_level_relative}, {"max_displacement", s.max_displacement},
           {"max_min_passes", s.worst_passes}, {"max_min_moves", s.worst_moves}};
 }
@@ -209,7 +211,7 @@ void run(const Args& a) {
   // Scans have no sharp features: every crease of their quads is a fold.
   const double feature_angle = a.feature_angle.value_or(a.shape.empty() ? 180.0 : 30.0);
   const std::vector<SurfaceSmoothingReport> smoothing =
-      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations, feature_angle, a.no_pillow, terminal);
+      a.no_surface_smoothing ? std::vector<SurfaceSmoothingReport>{} : smooth_surfaces(region, out, a.surface_iterations, a.surface_stall, feature_angle, a.no_pillow, terminal);
   const double smooth_time = seconds_since(t);
   for (std::size_t k = 0; k < smoothing.size(); ++k) print_smoothing(region.surfaces[k], smoothing[k]);
   if (!a.no_surface_smoothing) {
@@ -460,7 +462,12 @@ void register_mesh(CLI::App& app) {
                 "Skip the geometric-flow smoothing of the boundary quads (on by default; vertices stay on the isosurface)");
   cmd->add_option("--surface-iterations", a->surface_iterations,
                   "Most iterations of the surface smoothing (default 100; it stops earlier once no vertex moves more "
-                  "than 1e-4 of the mean boundary edge)")
+                  "than 1e-4 of the mean boundary edge, or once it stalls: --surface-stall)")
+      ->check(CLI::Range(0, 10000));
+  cmd->add_option("--surface-stall", a->surface_stall,
+                  "Stop the surface smoothing's relaxation once this many iterations in a row bring the boundary quads "
+                  "below 0.2 to no new low and raise their mean scaled Jacobian by less than 1e-4 in all (default 20; "
+                  "0: run to --surface-iterations or convergence)")
       ->check(CLI::Range(0, 10000));
   cmd->add_option("--feature-angle", a->feature_angle,
                   "Surface smoothing keeps creases where the isosurface's normal turns by more than this (degrees; "

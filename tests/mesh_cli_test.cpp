@@ -53,6 +53,19 @@ TEST(MeshCli, SurfaceSmoothingImprovesTheBoundaryAndKeepsItOnTheSurface) {
   EXPECT_LE(sm["max_relative_distance"].get<double>(), 1e-6);
   const HexMesh m = io::read_mesh(dir / "smooth.vtu");
   EXPECT_TRUE(validate(m).valid());
+
+  // --surface-stall: with 1 the relaxation stops at the first iteration that brings the quads
+  // below 0.2 to no new low and their mean up by less than 1e-4, and says so; the default ran longer.
+  ASSERT_EQ(run_cli("mesh --shape " + shape + " --resolution 14 --no-pillow --no-smooth --surface-stall 1 -o " +
+                        q(dir / "stall.vtu") + " --json " + q(dir / "stall.json"),
+                    &out),
+            0)
+      << out;
+  const auto st = nlohmann::json::parse(io::read_file(dir / "stall.json"))["surface_smoothing"][0];
+  EXPECT_TRUE(st["stalled"].get<bool>()) << st.dump();
+  EXPECT_NE(out.find("(stalled)"), std::string::npos) << out;
+  EXPECT_LT(st["iterations"].get<int>(), s["iterations"].get<int>());
+  EXPECT_LE(st["after"]["boundary_quads_below_0.2"].get<int>(), st["before"]["boundary_quads_below_0.2"].get<int>());
 }
 
 TEST(MeshCli, SmoothingIsDeterministicAcrossThreadCounts) {

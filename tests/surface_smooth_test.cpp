@@ -336,12 +336,42 @@ TEST(SurfaceSmoothing, OptimalBoundaryStaysPut) {
   HexMesh ball = jittered_ball(sphere, 8);
   SurfaceSmoothingOptions o;
   o.iterations = 1000;
+  o.stall_iterations = 0;  // the flow's own fixed point, not where the quads stop gaining
   const SurfaceSmoothingReport first = smooth_surface(ball, sphere, o);
   ASSERT_TRUE(first.converged);
   const SurfaceSmoothingReport again = smooth_surface(ball, sphere, o);
   EXPECT_LE(again.iterations, 2);
   EXPECT_LT(again.max_displacement, 1e-3 * first.max_displacement);  // measured 1e-5 vs 0.15
   EXPECT_NEAR(again.after.quad_sj_min, first.after.quad_sj_min, 1e-3);
+}
+
+// The stall rule stops the relaxation once the boundary quads stop gaining (no new low below
+// 0.2, the mean up by less than stall_gain over stall_iterations iterations); the quads it ends
+// with are as good as those of running on to the iteration limit.
+TEST(SurfaceSmoothing, StallStopsWhereTheQuadsStopGaining) {
+  const IsoField sphere(sphere_volume(), 0, Inside::below);
+  SurfaceSmoothingOptions full;
+  full.stall_iterations = 0;
+  full.convergence = 0;  // the limit alone
+  full.iterations = 60;
+  HexMesh a = jittered_ball(sphere, 10, 3);
+  const SurfaceSmoothingReport ra = smooth_surface(a, sphere, full);
+  EXPECT_EQ(ra.iterations, 60);
+  EXPECT_FALSE(ra.stalled);
+  SurfaceSmoothingOptions stall = full;
+  stall.stall_iterations = 5;
+  stall.stall_gain = 1e-3;
+  HexMesh b = jittered_ball(sphere, 10, 3);
+  const SurfaceSmoothingReport rb = smooth_surface(b, sphere, stall);
+  EXPECT_TRUE(rb.stalled);
+  EXPECT_FALSE(rb.converged);
+  EXPECT_LT(rb.iterations, 60);
+  EXPECT_GT(rb.iterations, 5);
+  // Not worse where it matters: the quads below 0.2, the worst quad, the mean.
+  EXPECT_LE(rb.after.quads_below, ra.after.quads_below + 1);
+  EXPECT_GE(rb.after.quad_sj_min, ra.after.quad_sj_min - 0.02);
+  EXPECT_NEAR(rb.after.quad_sj_mean, ra.after.quad_sj_mean, 2e-3);
+  EXPECT_EQ(rb.off_surface, 0u);
 }
 
 TEST(SurfaceSmoothing, CreasesArePinnedWhileFacesRelax) {
@@ -448,6 +478,9 @@ TEST(SurfaceSmoothing, RejectsBadInput) {
   o = {};
   o.iterations = -1;
   expect_error(ball, field, o, "iterations");
+  o = {};
+  o.stall_gain = -1;
+  expect_error(ball, field, o, "stall_gain");
   o = {};
   o.crease_angle_degrees = 0;
   expect_error(ball, field, o, "crease angle");

@@ -76,6 +76,8 @@ void check_inputs(const HexMesh& mesh, const IsoField& field, const SurfaceSmoot
   check_range("convergence", o.convergence, 0, 1);
   check_range("max_travel", o.max_travel, 1e-6, 100);
   check_range("worst_passes", o.worst_passes, 0, 1e6);
+  check_range("stall_iterations", o.stall_iterations, 0, 1e6);
+  check_range("stall_gain", o.stall_gain, 0, 1);
   check_range("worst_target", o.worst_target, 0, 1);
   check_range("worst_radius", o.worst_radius, 1e-9, 2);
   check_range("worst_levels", o.worst_levels, 1, 30);
@@ -307,8 +309,23 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
                   nullptr};
   const std::vector<std::int8_t> codes = options.planar.empty() ? std::vector<std::int8_t>{} : plane_codes(mesh, graph, options.planar);
   ctx.planar = &codes;
-  const std::vector<Vec3> start = mesh.points;
-  std::vector<double> curvature(static_cast<std::size_t>(nv), 0.0);
+  // Only the boundary and band vertices ever move: where they start and where each iteration
+  // found them are kept for them alone (three copies of every point were 39 MB on cthead h 2,
+  // and the stage's peak).
+  std::vector<Index> movable = boundary;
+  movable.insert(movable.end(), band.begin(), band.end());
+  const auto positions = [&] {
+    std::vector<Vec3> x(movable.size());
+    for (std::size_t i = 0; i < movable.size(); ++i) x[i] = mesh.points[movable[i]];
+    return x;
+  };
+  const auto farthest = [&](const std::vector<Vec3>& from) {  // the largest distance moved since `from`
+    double d = 0;
+    for (std::size_t i = 0; i < movable.size(); ++i) d = std::max(d, (mesh.points[movable[i]] - from[i]).norm());
+    return d;
+  };
+  const std::vector<Vec3> start = positions();
+  std::vector<double> curvature(options.normal_weight > 0 ? static_cast<std::size_t>(nv) : 0, 0.0);
   std::vector<MoveOutcome> outcome(static_cast<std::size_t>(nv), MoveOutcome::none);
   std::vector<Vec3> before_iteration;
 
@@ -323,8 +340,12 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
   ctx.anchor = &anchor;
   ctx.travel = &travel;
 
+  // The stall test's history (stall_iterations): the boundary quads after each iteration.
+  std::vector<QuadSummary> standing;
+  std::size_t lowest = std::numeric_limits<std::size_t>::max();
+  int since_low = 0;
   for (int it = 0; it < options.iterations; ++it) {
-    before_iteration = mesh.points;
+    before_iteration = positions();
     // Curvatures from one snapshot (Jacobi), so every vertex sees the same H field.
     if (options.normal_weight > 0)
       tbb::parallel_for(std::size_t{0}, boundary.size(), [&](std::size_t i) {
@@ -342,13 +363,26 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
         return surface_detail::move_interior_vertex(ctx, v, surface_detail::interior_step(ctx, v, options.interior_weight));
       });
     report.iterations = it + 1;
-    double moved = 0;
-    for (Index v = 0; v < nv; ++v) moved = std::max(moved, (mesh.points[v] - before_iteration[v]).norm());
+    const double moved = farthest(before_iteration);
     if (moved <= options.convergence * mean_edge) {
       report.converged = true;
       break;
     }
+    if (options.stall_iterations > 0) {
+      standing.push_back(summarize_quads(mesh, graph.quads));
+      since_low = standing.back().below < lowest ? 0 : since_low + 1;
+      lowest = std::min(lowest, standing.back().below);
+      const std::size_t k = static_cast<std::size_t>(options.stall_iterations);
+      if (since_low >= options.stall_iterations && standing.size() > k &&
+          standing.back().mean < standing[standing.size() - 1 - k].mean + options.stall_gain) {
+        report.stalled = true;
+        break;
+      }
+    }
   }
+  // Not needed past the relaxation (the max–min passes hold their own per-vertex normals).
+  std::vector<Vec3>().swap(before_iteration);
+  std::vector<QuadSummary>().swap(standing);
 
   std::vector<Index> sliding;  // features stay; folds that merely look like creases unfold
   std::vector<std::uint8_t> on_isosurface(static_cast<std::size_t>(nv), 0);
@@ -370,7 +404,7 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
     if (l > guarantee) ++report.off_surface;
   }
   report.max_level_relative = report.max_level / field.value_range();
-  for (Index v = 0; v < nv; ++v) report.max_displacement = std::max(report.max_displacement, (mesh.points[v] - start[v]).norm());
+  report.max_displacement = farthest(start);
   report.after = quality_of(mesh, graph);
   return report;
 }
