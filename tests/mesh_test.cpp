@@ -111,6 +111,23 @@ TEST(Topology, QuadsInTheOrderOfTheirSortedKeys) {
   }
   EXPECT_EQ(boundary_quads(m), expected_boundary);
   EXPECT_EQ(boundary_quads(quads), expected_boundary);
+
+  // face_neighbours(): the same pairs from the same sort, without the quads. Each face's first
+  // two hexes see each other; a boundary face (and a third hex on a face) sees -1.
+  const auto nb = face_neighbours(m);
+  ASSERT_EQ(nb.size(), m.hexes.size());
+  std::vector<std::array<Index, 6>> want(m.hexes.size());
+  for (auto& w : want) w.fill(-1);
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i + 1;
+    while (j < keys.size() && keys[j].key == keys[i].key) ++j;
+    if (j - i > 1) {
+      want[keys[i].hex_face / 6][keys[i].hex_face % 6] = keys[i + 1].hex_face / 6;
+      want[keys[i + 1].hex_face / 6][keys[i + 1].hex_face % 6] = keys[i].hex_face / 6;
+    }
+    i = j;
+  }
+  EXPECT_EQ(nb, want);
 }
 
 TEST(Topology, BoundaryQuadsPointOutward) {

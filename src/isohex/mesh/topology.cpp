@@ -98,6 +98,26 @@ std::vector<QuadFace> build_quads(const HexMesh& mesh) {
   });
 }
 
+std::vector<std::array<Index, 6>> face_neighbours(const HexMesh& mesh) {
+  std::vector<std::array<Index, 6>> nb(mesh.hexes.size());
+  for (auto& n : nb) n.fill(-1);
+  const Incidence inc = vertex_hexes(mesh);
+  const std::size_t nv = mesh.points.size(), block = 4096, blocks = (nv + block - 1) / block;
+  // Each face is met once, at its smallest vertex, and writes only its own hexes' entries.
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    thread_local std::vector<FaceKey> keys;
+    for (std::size_t v = b * block; v < std::min(nv, (b + 1) * block); ++v) {
+      faces_from(mesh, inc, static_cast<Index>(v), keys);
+      for_each_face(keys, [&](std::size_t i, std::size_t j) {
+        if (j - i < 2) return;
+        nb[keys[i].hex()][keys[i].face()] = keys[i + 1].hex();
+        nb[keys[i + 1].hex()][keys[i + 1].face()] = keys[i].hex();
+      });
+    }
+  });
+  return nb;
+}
+
 std::vector<Quad> boundary_quads(const std::vector<QuadFace>& quads) {
   std::vector<Quad> out;
   for (const QuadFace& q : quads)

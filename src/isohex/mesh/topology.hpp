@@ -26,6 +26,11 @@ struct QuadFace {
 /// rest in `extra_hexes`.
 std::vector<QuadFace> build_quads(const HexMesh& mesh);
 
+/// Per hex and local face (kHexFaces), the hex on the face's other side, -1 on the boundary
+/// (build_quads()'s hex[0] and hex[1] of each quad, without holding every quad: on cthead at
+/// h 2 those were 48 MB). A face used by more than two hexes links its first two only.
+std::vector<std::array<Index, 6>> face_neighbours(const HexMesh& mesh);
+
 /// The boundary quads (quads with one hex), each oriented outward (counter-clockwise seen
 /// from outside the mesh), in the order of build_quads.
 std::vector<Quad> boundary_quads(const HexMesh& mesh);

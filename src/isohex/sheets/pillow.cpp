@@ -37,22 +37,45 @@ void require_valid(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink_
   }
 }
 
-/// The interface quads (see pillow.hpp), in build_quads order.
-std::vector<InterfaceQuad> find_interface(const std::vector<QuadFace>& quads, const std::vector<std::uint8_t>& in,
-                                          bool include_boundary) {
-  std::vector<InterfaceQuad> out;
-  for (const QuadFace& q : quads) {
-    const bool s0 = in[q.hex[0]] != 0;
-    if (q.is_boundary()) {
-      if (s0 && include_boundary) out.push_back({q.vertices, q.hex[0], -1});
-      continue;
+/// The interface quads (see pillow.hpp), in build_quads() order and as it orients them: seen
+/// from the face's first hex in that order (the lower hex·6 + face), reversed when that hex is
+/// outside. Found from the face neighbours, without every quad of the mesh.
+std::vector<InterfaceQuad> find_interface(const HexMesh& mesh, const std::vector<std::array<Index, 6>>& nb,
+                                          const std::vector<std::uint8_t>& in, bool include_boundary) {
+  const auto face_of = [&](Index h, int f) {
+    const Hex& x = mesh.hexes[h];
+    return Quad{x[kHexFaces[f][0]], x[kHexFaces[f][1]], x[kHexFaces[f][2]], x[kHexFaces[f][3]]};
+  };
+  const auto sorted = [](Quad q) {
+    std::sort(q.begin(), q.end());
+    return q;
+  };
+  std::vector<std::pair<Quad, InterfaceQuad>> found;  // (sorted vertices, quad)
+  for (Index h = 0; h < mesh.num_hexes(); ++h) {
+    if (!in[h]) continue;
+    for (int f = 0; f < 6; ++f) {
+      const Index g = nb[h][f];
+      const Quad q = face_of(h, f);
+      if (g < 0) {
+        if (include_boundary) found.push_back({sorted(q), {q, h, -1}});
+        continue;
+      }
+      if (in[g]) continue;
+      const Quad key = sorted(q);
+      int fg = 0;  // g's own number for the face
+      while (fg < 6 && !(nb[g][fg] == h && sorted(face_of(g, fg)) == key)) ++fg;
+      if (fg == 6 || h * 6 + f < g * 6 + fg) {
+        found.push_back({key, {q, h, g}});
+      } else {
+        const Quad o = face_of(g, fg);  // as seen from g, reversed
+        found.push_back({key, {{o[0], o[3], o[2], o[1]}, h, g}});
+      }
     }
-    const bool s1 = in[q.hex[1]] != 0;
-    if (s0 == s1) continue;
-    if (s0) out.push_back({q.vertices, q.hex[0], q.hex[1]});
-    else  // seen from hex[1]
-      out.push_back({{q.vertices[0], q.vertices[3], q.vertices[2], q.vertices[1]}, q.hex[1], q.hex[0]});
   }
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<InterfaceQuad> out;
+  out.reserve(found.size());
+  for (const auto& [key, q] : found) out.push_back(q);
   return out;
 }
 
@@ -68,12 +91,7 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
   if (!(options.offset > 0 && options.offset < 1))
     throw Error(fmt::format("pillow: offset must be in (0, 1), got {}", options.offset));
   require_valid(mesh, shrink_set);
-  std::vector<QuadFace> quads = build_quads(mesh);
-  std::vector<std::array<Index, 6>> nb(mesh.hexes.size());
-  for (const QuadFace& q : quads) {
-    nb[q.hex[0]][q.local[0]] = q.hex[1];
-    if (!q.is_boundary()) nb[q.hex[1]][q.local[1]] = q.hex[0];
-  }
+  std::vector<std::array<Index, 6>> nb = face_neighbours(mesh);
   // A pinch that no choice of merge sides can place (e.g. two outside hexes meeting along an
   // edge inside the shrink set where the edge's other end needs the opposite choice) is undone
   // by flipping one hex there, and the split redone; the flips are reported.
@@ -84,7 +102,7 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
   detail::InterfaceSplit split;
   Incidence hex_inc = vertex_hexes(mesh);
   for (int round = 0;; ++round) {
-    iq = find_interface(quads, in, options.include_boundary);
+    iq = find_interface(mesh, nb, in, options.include_boundary);
     if (iq.empty())
       throw Error(options.include_boundary
                       ? "pillow: the shrink set has no interface (no quad between it and the rest of the mesh, and "
@@ -112,9 +130,7 @@ PillowResult pillow(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink
     if (!flipped) break;
   }
 
-  // Every quad of the mesh (cthead h 2: 47 MB) is not needed past the interface: freed
-  // before the new mesh is built, where the stage's memory peaks.
-  std::vector<QuadFace>().swap(quads);
+  // The face neighbours are not needed past the interface: freed before the new mesh is built.
   std::vector<std::array<Index, 6>>().swap(nb);
   hex_inc = Incidence{};  // 18 MB on cthead h 2, not needed past the flips either
 
