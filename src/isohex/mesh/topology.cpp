@@ -23,10 +23,6 @@ struct FaceKey {
   [[nodiscard]] int face() const { return static_cast<int>(hex_face % 6); }
 };
 
-Quad face_vertices(const Hex& h, int f) {
-  return {h[kHexFaces[f][0]], h[kHexFaces[f][1]], h[kHexFaces[f][2]], h[kHexFaces[f][3]]};
-}
-
 // Calls f(i, j) for each run keys[i..j) of one face (sorted keys).
 template <class F>
 void for_each_face(const std::vector<FaceKey>& keys, F&& f) {
@@ -57,6 +53,22 @@ void faces_from(const HexMesh& mesh, const Incidence& inc, Index v, std::vector<
   std::sort(keys.begin(), keys.end());
 }
 
+// Vertices per block of the face scans below: blocks in parallel, each face met once, at its
+// smallest vertex.
+constexpr std::size_t kFaceBlock = 4096;
+std::size_t face_blocks(const HexMesh& mesh) { return (mesh.points.size() + kFaceBlock - 1) / kFaceBlock; }
+
+// Calls f(keys, i, j) for each face (the run keys[i..j) of its references, sorted) whose
+// smallest vertex lies in block b, in vertex order.
+template <class F>
+void faces_of_block(const HexMesh& mesh, const Incidence& inc, std::size_t b, F&& f) {
+  thread_local std::vector<FaceKey> keys;
+  for (std::size_t v = b * kFaceBlock; v < std::min(mesh.points.size(), (b + 1) * kFaceBlock); ++v) {
+    faces_from(mesh, inc, static_cast<Index>(v), keys);
+    for_each_face(keys, [&](std::size_t i, std::size_t j) { f(keys, i, j); });
+  }
+}
+
 // One T per face for which make(keys, i, j, out) returns true (writing it to *out unless out is
 // null), in the order of a sort of every hex face's key (the faces of smallest vertex v come
 // before those of v + 1), without holding every key: on cthead h 2 those were 70 MB, the peak
@@ -65,14 +77,12 @@ void faces_from(const HexMesh& mesh, const Incidence& inc, Index v, std::vector<
 template <class T, class Make>
 std::vector<T> collect_faces(const HexMesh& mesh, Make&& make) {
   const Incidence inc = vertex_hexes(mesh);
-  const std::size_t nv = mesh.points.size(), block = 4096, blocks = (nv + block - 1) / block;
+  const std::size_t blocks = face_blocks(mesh);
   const auto scan = [&](std::size_t b, T* out) {
-    thread_local std::vector<FaceKey> keys;
     std::size_t n = 0;
-    for (std::size_t v = b * block; v < std::min(nv, (b + 1) * block); ++v) {
-      faces_from(mesh, inc, static_cast<Index>(v), keys);
-      for_each_face(keys, [&](std::size_t i, std::size_t j) { n += make(keys, i, j, out ? out + n : nullptr); });
-    }
+    faces_of_block(mesh, inc, b, [&](const std::vector<FaceKey>& keys, std::size_t i, std::size_t j) {
+      n += make(keys, i, j, out ? out + n : nullptr);
+    });
     return n;
   };
   std::vector<std::size_t> offset(blocks + 1, 0);
@@ -102,18 +112,13 @@ std::vector<std::array<Index, 6>> face_neighbours(const HexMesh& mesh) {
   std::vector<std::array<Index, 6>> nb(mesh.hexes.size());
   for (auto& n : nb) n.fill(-1);
   const Incidence inc = vertex_hexes(mesh);
-  const std::size_t nv = mesh.points.size(), block = 4096, blocks = (nv + block - 1) / block;
-  // Each face is met once, at its smallest vertex, and writes only its own hexes' entries.
-  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
-    thread_local std::vector<FaceKey> keys;
-    for (std::size_t v = b * block; v < std::min(nv, (b + 1) * block); ++v) {
-      faces_from(mesh, inc, static_cast<Index>(v), keys);
-      for_each_face(keys, [&](std::size_t i, std::size_t j) {
-        if (j - i < 2) return;
-        nb[keys[i].hex()][keys[i].face()] = keys[i + 1].hex();
-        nb[keys[i + 1].hex()][keys[i + 1].face()] = keys[i].hex();
-      });
-    }
+  // Each face writes only its own hexes' entries.
+  tbb::parallel_for(std::size_t{0}, face_blocks(mesh), [&](std::size_t b) {
+    faces_of_block(mesh, inc, b, [&](const std::vector<FaceKey>& keys, std::size_t i, std::size_t j) {
+      if (j - i < 2) return;
+      nb[keys[i].hex()][keys[i].face()] = keys[i + 1].hex();
+      nb[keys[i + 1].hex()][keys[i + 1].face()] = keys[i].hex();
+    });
   });
   return nb;
 }

@@ -26,6 +26,11 @@ struct QuadFace {
 /// rest in `extra_hexes`.
 std::vector<QuadFace> build_quads(const HexMesh& mesh);
 
+/// The vertices of local face f (kHexFaces) of hex h, counter-clockwise seen from outside h.
+inline Quad face_vertices(const Hex& h, int f) {
+  return {h[kHexFaces[f][0]], h[kHexFaces[f][1]], h[kHexFaces[f][2]], h[kHexFaces[f][3]]};
+}
+
 /// Per hex and local face (kHexFaces), the hex on the face's other side, -1 on the boundary
 /// (build_quads()'s hex[0] and hex[1] of each quad, without holding every quad: on cthead at
 /// h 2 those were 48 MB). A face used by more than two hexes links its first two only.

@@ -42,10 +42,7 @@ void require_valid(const HexMesh& mesh, const std::vector<std::uint8_t>& shrink_
 /// outside. Found from the face neighbours, without every quad of the mesh.
 std::vector<InterfaceQuad> find_interface(const HexMesh& mesh, const std::vector<std::array<Index, 6>>& nb,
                                           const std::vector<std::uint8_t>& in, bool include_boundary) {
-  const auto face_of = [&](Index h, int f) {
-    const Hex& x = mesh.hexes[h];
-    return Quad{x[kHexFaces[f][0]], x[kHexFaces[f][1]], x[kHexFaces[f][2]], x[kHexFaces[f][3]]};
-  };
+  const auto face_of = [&](Index h, int f) { return face_vertices(mesh.hexes[h], f); };
   const auto sorted = [](Quad q) {
     std::sort(q.begin(), q.end());
     return q;

@@ -314,17 +314,17 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
   // and the stage's peak).
   std::vector<Index> movable = boundary;
   movable.insert(movable.end(), band.begin(), band.end());
-  const auto positions = [&] {
-    std::vector<Vec3> x(movable.size());
+  const auto take = [&](std::vector<Vec3>& x) {  // into x's own buffer: no allocation per iteration
+    x.resize(movable.size());
     for (std::size_t i = 0; i < movable.size(); ++i) x[i] = mesh.points[movable[i]];
-    return x;
   };
   const auto farthest = [&](const std::vector<Vec3>& from) {  // the largest distance moved since `from`
     double d = 0;
     for (std::size_t i = 0; i < movable.size(); ++i) d = std::max(d, (mesh.points[movable[i]] - from[i]).norm());
     return d;
   };
-  const std::vector<Vec3> start = positions();
+  std::vector<Vec3> start;
+  take(start);
   std::vector<double> curvature(options.normal_weight > 0 ? static_cast<std::size_t>(nv) : 0, 0.0);
   std::vector<MoveOutcome> outcome(static_cast<std::size_t>(nv), MoveOutcome::none);
   std::vector<Vec3> before_iteration;
@@ -345,7 +345,7 @@ SurfaceSmoothingReport smooth_surface(HexMesh& mesh, const IsoField& field, cons
   std::size_t lowest = std::numeric_limits<std::size_t>::max();
   int since_low = 0;
   for (int it = 0; it < options.iterations; ++it) {
-    before_iteration = positions();
+    take(before_iteration);
     // Curvatures from one snapshot (Jacobi), so every vertex sees the same H field.
     if (options.normal_weight > 0)
       tbb::parallel_for(std::size_t{0}, boundary.size(), [&](std::size_t i) {
