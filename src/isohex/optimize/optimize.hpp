@@ -281,6 +281,11 @@ struct WorstOptions {
   int stall_passes = 10;
   double stall_gain = 1e-3;
   double stall_fraction = 0.01;
+  /// The same test over this many passes for the single passes that follow a round of joint
+  /// moves or a walk: those passes resume from a stall, and what the joint move opened up they
+  /// take in the first two or three (cthead h 2's release round: 97 -> 59 passes, the same
+  /// minimum 0.2011; h 4: 92 -> 65, the same 0.2009).
+  int resume_stall_passes = 3;
   /// A move of a vertex: the max–min LP step within a box of half-side `step` × its mean edge
   /// length, halved up to `trials` times until the true values gain, the model rebuilt up to
   /// `models` times at the new place.
@@ -314,7 +319,7 @@ struct WorstOptions {
   /// alone with the ratio terms held at their smallest (LP constraints).
   bool ratio_terms = true;
   /// After the single moves: up to this many rounds of joint moves (0: none), each followed by
-  /// up to 10 more single passes. A max–min ascent one vertex at a time stops where two
+  /// up to 10 more single passes (stopping at a stall over `resume_stall_passes`). A max–min ascent one vertex at a time stops where two
   /// vertices' terms tie and either moving alone lowers the other's (cthead's bone at iso 1200,
   /// h 5: four pillow hexes at ratios 0.05-0.06 through 100 passes). Each cluster of hexes
   /// still below 0.2 by the pass's rank (sharing vertices) has the free vertices of its hexes

@@ -384,7 +384,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   const auto floor_of = [&](double min_now) { return options.ratio_terms ? std::max(options.sj_floor, min_now) : 0.0; };
   using Clock = std::chrono::steady_clock;
   const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
-  const auto untimed_passes = [&](int passes) {
+  const auto untimed_passes = [&](int passes, int stall_passes) {
     std::vector<Standing> history;
     for (int end = pass + passes; pass < end;) {
       sort_worst_first();
@@ -394,8 +394,8 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       // tail (cthead h 4: 100 passes at a minimum of 0.163 that only the walk raised; with the
       // minimum alone, pave1 fixed ended at 0.303 instead of 0.403).
       history.push_back(standing());
-      if (options.stall_passes > 0 && history.size() > static_cast<std::size_t>(options.stall_passes)) {
-        const Standing& then = history[history.size() - 1 - static_cast<std::size_t>(options.stall_passes)];
+      if (stall_passes > 0 && history.size() > static_cast<std::size_t>(stall_passes)) {
+        const Standing& then = history[history.size() - 1 - static_cast<std::size_t>(stall_passes)];
         const Standing& now = history.back();
         const bool stalled = then.deficit > 0 ? now.deficit >= (1 - options.stall_fraction) * then.deficit
                                               : now.tail < then.tail + options.stall_gain;
@@ -432,12 +432,12 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       if (moved == 0) break;
     }
   };
-  const auto single_passes = [&](int passes) {
+  const auto single_passes = [&](int passes, int stall_passes) {
     const auto t0 = Clock::now();
-    untimed_passes(passes);
+    untimed_passes(passes, stall_passes);
     res.passes_seconds += since(t0);
   };
-  single_passes(options.passes);
+  single_passes(options.passes, options.stall_passes);
   // The end game: each cluster of hexes still below 0.2 by rank with the free vertices of its
   // hexes moved together, or where that gains nothing those of its worst hex (or of the hexes
   // around its worst frame); the single moves again after a round that moved something.
@@ -506,7 +506,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     res.min_sj_after = mesh_min();
     if (options.progress) options.progress({"patch", round + 1, static_cast<double>(moved), res.min_sj_after, 0});
     if (moved == 0) break;
-    single_passes(std::min(options.passes, 10));
+    single_passes(std::min(options.passes, 10), options.resume_stall_passes);
   }
   // Last resort: the random walk round each cluster still below 0.2 by rank (`member`), its
   // minimum over the hexes not in `hold`.
@@ -533,7 +533,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     res.search_gains += gains;
     res.min_sj_after = mesh_min();
     if (options.progress) options.progress({"search", 1, static_cast<double>(gains), res.min_sj_after, 0});
-    if (gains > 0) single_passes(std::min(options.passes, 10));
+    if (gains > 0) single_passes(std::min(options.passes, 10), options.resume_stall_passes);
   };
   // Every poor hex first (a proven one still gains towards its bound: bust_in fixed, ratio
   // -0.097 -> -0.034), then, where proofs hold some, the others alone: next to a proven hex
