@@ -200,12 +200,13 @@ void run(const Args& a) {
              r.grid.h);
 
   std::vector<StageRow> rows;
-  rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes));
+  const bool keep_values = !a.report.empty();  // the report's histograms
+  rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes, keep_values));
   nlohmann::json refinement;
   if (a.refine_tolerance) {
     double seconds = 0;
     refinement = refine_stage(region, out, *a.refine_tolerance, a.refine_levels, terminal, seconds);
-    rows.push_back(stage_row("boundary refinement", out.mesh, seconds));
+    rows.push_back(stage_row("boundary refinement", out.mesh, seconds, keep_values));
   }
   auto t = Clock::now();
   // Scans have no sharp features: every crease of their quads is a fold.
@@ -215,7 +216,7 @@ void run(const Args& a) {
   const double smooth_time = seconds_since(t);
   for (std::size_t k = 0; k < smoothing.size(); ++k) print_smoothing(region.surfaces[k], smoothing[k]);
   if (!a.no_surface_smoothing) {
-    rows.push_back(stage_row("surface smoothing", out.mesh, smooth_time));
+    rows.push_back(stage_row("surface smoothing", out.mesh, smooth_time, keep_values));
     for (std::size_t k = 0; k < smoothing.size(); ++k) {
       const SurfaceSmoothingReport& sr = smoothing[k];
       if (!region.surfaces[k].field()) continue;
@@ -230,7 +231,7 @@ void run(const Args& a) {
   if (!a.no_pillow) {
     t = Clock::now();
     pillowing = pillow_stage(out.mesh, out.vertex_place, region.domain, terminal);
-    rows.push_back(stage_row("pillowing", out.mesh, seconds_since(t)));
+    rows.push_back(stage_row("pillowing", out.mesh, seconds_since(t), keep_values));
     rows.back().extra = pillowing;
   }
   release_free_memory();
@@ -242,7 +243,7 @@ void run(const Args& a) {
     if (slides)
       slide = {&region, &out.vertex_place, feature_angle, a.surface_band * r.grid.h};
     optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide, &released);
-    rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t)));
+    rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t), keep_values));
     rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
                          {"shape sweeps", optimisation["shape"]["iterations"]},
                          {"worst moves", optimisation["worst"]["moves"]}};

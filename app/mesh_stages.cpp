@@ -20,9 +20,10 @@
 
 namespace isohex::cli {
 
-StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds) {
+StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds, bool keep_values) {
   StageRow r{name, mesh.num_hexes(), mesh.num_vertices(), scaled_jacobians(mesh), {}, seconds, nlohmann::json::object()};
   r.sj = summarize(HexMetric::scaled_jacobian, r.sj_values, 0);
+  if (!keep_values) std::vector<double>().swap(r.sj_values);
   return r;
 }
 

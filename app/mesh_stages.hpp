@@ -21,14 +21,16 @@ namespace isohex::cli {
 struct StageRow {
   std::string name;
   Index hexes = 0, vertices = 0;
-  std::vector<double> sj_values;  ///< per hex (for the report's histograms)
+  std::vector<double> sj_values;  ///< per hex, for the report's histograms (empty without a report)
   MetricSummary sj;
   double seconds = 0;
   nlohmann::json extra = nlohmann::json::object();  ///< the stage's facts
 };
 
-/// Summarises `mesh` (scaled Jacobians computed here) as the row of stage `name`.
-StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds);
+/// Summarises `mesh` (scaled Jacobians computed here) as the row of stage `name`, keeping the
+/// per-hex values only if `keep_values` (a report's histograms need them; without one, four
+/// stages of cthead h 2 held 16 MiB of them to the end of the run).
+StageRow stage_row(const std::string& name, const HexMesh& mesh, double seconds, bool keep_values);
 
 /// Boundary pillowing: one sheet of hexes inside the whole boundary, the surface kept as it is.
 /// `vertex_place` (one entry per vertex, see contour::ExtractResult) grows with the new

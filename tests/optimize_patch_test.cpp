@@ -186,3 +186,24 @@ TEST(OptimizePatch, SinglePassesStopWhenTheyStall) {
   std::printf("stopped after %d passes at %.4f; to the end %d passes, %.4f\n", s.passes, lowest_rank(stopped, targets),
               f.passes, lowest_rank(full, targets));
 }
+
+// The single passes after a round of joint moves stop at a stall over resume_stall_passes (3):
+// fewer passes than running each batch's ten (the old rule), the joint moves still made, and no
+// lower a minimum.
+TEST(OptimizePatch, PassesAfterJointMovesStopAtAShorterStall) {
+  std::vector<Index> targets;
+  const HexMesh before = bone_cluster(targets, true);
+  WorstOptions o;
+  o.search_trials = 0;  // the joint moves' rounds alone
+  HexMesh shorter = before;
+  const WorstResult s = improve_worst(shorter, shorter.fixed, o);
+  o.resume_stall_passes = o.stall_passes;
+  HexMesh longer = before;
+  const WorstResult l = improve_worst(longer, longer.fixed, o);
+  EXPECT_GT(s.patch_moves, 0u);
+  EXPECT_LT(s.passes, l.passes);
+  EXPECT_GE(s.min_sj_after, s.min_sj_before);
+  EXPECT_GE(lowest_rank(shorter, targets), lowest_rank(longer, targets) - 1e-9);
+  std::printf("after joint moves: %d passes, lowest rank %.4f; with batches of ten %d passes, %.4f\n", s.passes,
+              lowest_rank(shorter, targets), l.passes, lowest_rank(longer, targets));
+}

@@ -120,9 +120,13 @@ UntangleResult untangle(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, c
     res.min_sj = s.min;
     res.iterations = iterations;
     res.inverted = skipped ? opt::sj_stats(mesh).inverted : s.inverted;
-    const std::vector<double> sj = certified_scaled_jacobians(mesh);
-    for (Index h = 0; h < mesh.num_hexes(); ++h)
-      if (hex_eps[h] > 0 && (sj[h] <= 0 || is_degenerate(sj[h]))) res.stuck.push_back(h);
+    // Only the stuck hexes are measured: a whole-mesh vector here, beside the iteration's
+    // per-hex arrays, was cthead h 2's peak.
+    for (Index h = 0; h < mesh.num_hexes(); ++h) {
+      if (!(hex_eps[h] > 0)) continue;
+      const double sj = certified_scaled_jacobian(mesh.corners(h));
+      if (sj <= 0 || is_degenerate(sj)) res.stuck.push_back(h);
+    }
     return res;
   };
 
