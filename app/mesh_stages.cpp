@@ -137,6 +137,7 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
     j["worst"] = {{"passes", w.passes},
                   {"moves", w.moves},
                   {"patch_moves", w.patch_moves},
+                  {"patch_skipped", w.patch_skipped},
                   {"searched", w.searched},
                   {"search_gains", w.search_gains},
                   {"min_sj_before", w.min_sj_before},

@@ -207,3 +207,33 @@ TEST(OptimizePatch, PassesAfterJointMovesStopAtAShorterStall) {
   std::printf("after joint moves: %d passes, lowest rank %.4f; with batches of ten %d passes, %.4f\n", s.passes,
               lowest_rank(shorter, targets), l.passes, lowest_rank(longer, targets));
 }
+
+// The joint moves' memo (WorstOptions::patch_memo): a cluster whose tries all failed is not
+// tried again while nothing they read has changed. Two copies of the bone's cluster side by
+// side, one with its boundary held (its joint moves fail), one free (they succeed, so the
+// rounds go on): the held one is skipped, and the mesh is the same, bit for bit, as trying it
+// again each round.
+TEST(OptimizePatch, FailedClustersAreSkippedWithTheSameMesh) {
+  std::vector<Index> targets;
+  HexMesh both = bone_cluster(targets, false);
+  const HexMesh free_copy = bone_cluster(targets, true);
+  const Index offset = both.num_vertices();
+  for (const Vec3& p : free_copy.points) both.points.push_back(p + Vec3(1000, 0, 0));
+  both.fixed.insert(both.fixed.end(), free_copy.fixed.begin(), free_copy.fixed.end());
+  for (Hex h : free_copy.hexes) {
+    for (Index& v : h) v += offset;
+    both.hexes.push_back(h);
+  }
+  WorstOptions o;
+  o.search_trials = 0;
+  HexMesh with = both, without = both;
+  const WorstResult a = improve_worst(with, with.fixed, o);
+  o.patch_memo = false;
+  const WorstResult b = improve_worst(without, without.fixed, o);
+  EXPECT_GT(a.patch_moves, 0u);
+  EXPECT_GT(a.patch_skipped, 0u);
+  EXPECT_EQ(b.patch_skipped, 0u);
+  EXPECT_EQ(a.patch_moves, b.patch_moves);
+  EXPECT_EQ(with.points, without.points);
+  std::printf("%zu joint moves, %zu clusters skipped\n", a.patch_moves, a.patch_skipped);
+}

@@ -327,6 +327,9 @@ struct WorstOptions {
   /// nothing those of its worst hex, under the same guards as a single move.
   int patch_rounds = 5;
   std::size_t patch_size = 48;  ///< ... at most this many vertices in one patch
+  /// ... and a cluster whose tries all failed is not tried again in the next round while nothing
+  /// they read has changed (WorstResult::patch_skipped; the same mesh either way)
+  bool patch_memo = true;
   /// ... and only while at most this many hexes are below 0.2 by rank: more are not stalls of
   /// the single moves but a region no joint move repairs (headsq with its boundary fixed kept
   /// 746 through five rounds that cost 6 times the rest of the stage).
@@ -352,6 +355,9 @@ struct WorstResult {
   int passes = 0;
   std::size_t moves = 0;
   std::size_t patch_moves = 0;  ///< joint moves of patches (WorstOptions::patch_rounds)
+  /// clusters not tried again in a round: their tries had all failed, and nothing they read had
+  /// changed since (the same mesh as trying them)
+  std::size_t patch_skipped = 0;
   std::size_t searched = 0, search_gains = 0;  ///< clusters the random search ran on, and raised
   double min_sj_before = 0, min_sj_after = 0;
   /// Wall seconds of the single passes, the joint moves of patches and the random walks.
