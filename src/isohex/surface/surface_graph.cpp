@@ -1,8 +1,6 @@
 #include "isohex/surface/surface_graph.hpp"
 
 #include <algorithm>
-#include <limits>
-#include <unordered_map>
 #include <array>
 #include <tuple>
 
@@ -146,26 +144,34 @@ std::vector<std::vector<Index>> read_disjoint_classes(const std::vector<Index>& 
     for (Index k = graph.boundary_neighbours.offsets[v]; k < graph.boundary_neighbours.offsets[v + 1]; ++k)
       each_quad_vertex(graph.boundary_neighbours.ids[k]);
   };
-  // Who reads whom, both ways: (reader, read) pairs sorted by the read vertex.
-  std::vector<std::array<Index, 2>> pairs;
-  for (Index v : vertices) reads(v, [&](Index x) { pairs.push_back({x, v}); });
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  std::unordered_map<Index, int> colour;
+  // Who reads whom, both ways: the readers of each vertex, bucketed by counting (the max–min
+  // passes build these classes every pass; sorting every (read, reader) pair and a hash map of
+  // colours were a tenth of cthead h 2's surface stage). Repeats in a bucket mark twice, which
+  // changes nothing.
+  const std::size_t nv = graph.vertex_quads.offsets.size() - 1;
+  std::vector<Index> first(nv + 1, 0);
+  for (Index v : vertices) reads(v, [&](Index x) { ++first[static_cast<std::size_t>(x) + 1]; });
+  for (std::size_t x = 0; x < nv; ++x) first[x + 1] += first[x];
+  std::vector<Index> readers(static_cast<std::size_t>(first[nv]));
+  {
+    std::vector<Index> next(first.begin(), first.end() - 1);
+    for (Index v : vertices) reads(v, [&](Index x) { readers[static_cast<std::size_t>(next[static_cast<std::size_t>(x)]++)] = v; });
+  }
+  std::vector<int> colour(nv, -1);
   std::vector<std::vector<Index>> classes;
   std::vector<char> used;
   for (Index v : vertices) {
     used.assign(classes.size() + 1, 0);
     const auto mark = [&](Index x) {
-      if (const auto it = colour.find(x); it != colour.end()) used[static_cast<std::size_t>(it->second)] = 1;
+      if (const int c = colour[static_cast<std::size_t>(x)]; c >= 0) used[static_cast<std::size_t>(c)] = 1;
     };
     reads(v, mark);  // those v reads
-    auto it = std::lower_bound(pairs.begin(), pairs.end(), std::array<Index, 2>{v, std::numeric_limits<Index>::min()});
-    for (; it != pairs.end() && (*it)[0] == v; ++it) mark((*it)[1]);  // those that read v
+    for (Index k = first[static_cast<std::size_t>(v)]; k < first[static_cast<std::size_t>(v) + 1]; ++k)
+      mark(readers[static_cast<std::size_t>(k)]);  // those that read v
     const auto c = static_cast<std::size_t>(std::find(used.begin(), used.end(), 0) - used.begin());
     if (c == classes.size()) classes.emplace_back();
     classes[c].push_back(v);
-    colour[v] = static_cast<int>(c);
+    colour[static_cast<std::size_t>(v)] = static_cast<int>(c);
   }
   return classes;
 }
