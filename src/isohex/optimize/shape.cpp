@@ -15,7 +15,9 @@ namespace {
 // Hexes that the barrier cannot see (some frame determinant <= 0): left out of the objective.
 std::vector<std::uint8_t> infeasible_hexes(const HexMesh& mesh, const std::vector<double>& inv_len) {
   std::vector<std::uint8_t> bad(mesh.hexes.size(), 0);
-  for (Index h = 0; h < mesh.num_hexes(); ++h) bad[h] = !opt::hex_feasible(mesh.corners(h), inv_len[h]);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, mesh.num_hexes(), 1024), [&](const auto& r) {
+    for (Index h = r.begin(); h != r.end(); ++h) bad[h] = !opt::hex_feasible(mesh.corners(h), inv_len[h]);
+  });
   return bad;
 }
 
