@@ -201,7 +201,8 @@ void run(const Args& a) {
 
   std::vector<StageRow> rows;
   const bool keep_values = !a.report.empty();  // the report's histograms
-  rows.push_back(stage_row("extraction", out.mesh, r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes, keep_values));
+  const double extraction_time = r.time_sample + r.time_repair + r.time_components + r.time_vertices + r.time_hexes;
+  rows.push_back(stage_row("extraction", out.mesh, extraction_time, keep_values));
   nlohmann::json refinement;
   if (a.refine_tolerance) {
     double seconds = 0;
