@@ -490,7 +490,8 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--surface-band", a->surface_band,
                   "With --boundary slide: where hexes stay below 0.2 with their boundary on the surface (knife edges "
                   "thinner than a cell), release those boundary vertices into a band of this many cell sizes about "
-                  "their surface and optimise again (default 0.3; 0: every vertex stays on its surface)")
+                  "their surface and optimise again (default 0.3; 0: every vertex stays on its surface); rounds that "
+                  "leave a hex invalid run again in a band 5/3 as wide, and the better run is kept")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");

@@ -229,7 +229,8 @@ void register_smooth(CLI::App& app) {
       ->check(CLI::Range(0.0, 180.0));
   cmd->add_option("--surface-band", a->surface_band,
                   "With --boundary slide: release the boundary vertices of hexes still below 0.2 into a band of this "
-                  "many mean boundary edge lengths about their surface and optimise again (default 0: off)")
+                  "many mean boundary edge lengths about their surface and optimise again (default 0: off); rounds that "
+                  "leave a hex invalid run again in a band 5/3 as wide, and the better run is kept")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--max-iter", a->max_iter,
                   "Iteration limit of the untangler and the shape stage (default 200 and 100; the untangler "

@@ -231,10 +231,40 @@ class ReleaseRings {
   std::vector<Index> ring_, members_;
 };
 
-}  // namespace
+// The places, before the first release round, of the vertices the rounds moved: what running
+// them again needs, without a copy of every point (cthead h 2: 15 MiB).
+class RoundJournal {
+ public:
+  explicit RoundJournal(std::size_t vertices) : noted_(vertices, 0) {}
+  /// Before a round that moves the vertices not `held`.
+  void note(const HexMesh& mesh, const std::vector<std::uint8_t>& held) {
+    for (std::size_t v = 0; v < held.size(); ++v)
+      if (!held[v] && !noted_[v]) noted_[v] = 1, ids_.push_back(static_cast<Index>(v)), at_.push_back(mesh.points[v]);
+  }
+  /// Every noted vertex back where it was.
+  void restore(HexMesh& mesh) const {
+    for (std::size_t i = 0; i < ids_.size(); ++i) mesh.points[ids_[i]] = at_[i];
+  }
+  /// The places now of the noted vertices (to put back after another run's restore()).
+  [[nodiscard]] std::vector<Vec3> places(const HexMesh& mesh) const {
+    std::vector<Vec3> p;
+    p.reserve(ids_.size());
+    for (Index v : ids_) p.push_back(mesh.points[v]);
+    return p;
+  }
+  void put(HexMesh& mesh, const std::vector<Vec3>& places) const {
+    for (std::size_t i = 0; i < ids_.size(); ++i) mesh.points[ids_[i]] = places[i];
+  }
 
-nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& o,
-                              std::size_t* reattached) {
+ private:
+  std::vector<std::uint8_t> noted_;
+  std::vector<Index> ids_;
+  std::vector<Vec3> at_;
+};
+
+// The release rounds in one band (release_rounds()); the score they end with into `score`.
+nlohmann::json rounds_in_band(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& o,
+                              const Incidence& inc, RoundScore& score, RoundJournal& journal) {
   nlohmann::json released = nlohmann::json::array();
   // Where the surface itself leaves no valid or good place for the hexes at it (knife edges
   // one voxel thick), its vertices of those hexes are released into the band and the whole
@@ -250,10 +280,8 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
   // stage's 30 passes (headsq: 0.097 -> 0.174 in its second round's 30).
   OptimizeOptions rounds = o;
   rounds.worst_options.passes = std::max(o.worst_options.passes, 100);
-  const Incidence inc = vertex_hexes(mesh);
   // One incidence for the rounds and every stage in them (the connectivity does not change).
   rounds.untangle_options.incidence = rounds.shape_options.incidence = rounds.worst_options.incidence = &inc;
-  RoundScore score;
   std::vector<double> sj = round_ranks(mesh, score);
   for (int round = 1; round <= 5; ++round) {
     // Hexes that need the release: below 0.2 by the certified scaled Jacobian, or valid inside
@@ -278,6 +306,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
     const std::vector<std::uint8_t> pinned = surface.fixed_mask();
     for (std::size_t v = 0; v < held.size(); ++v) held[v] = held[v] || pinned[v];
     const PointSnapshot points(mesh, held);  // the round moves none of the held vertices
+    journal.note(mesh, held);
     nlohmann::json again = run_optimisation(mesh, held, rounds);
     again["released"] = n;
     RoundScore after;
@@ -313,6 +342,48 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double ba
     // 0.180). The first round needs it free: its released vertices are far from their best
     // places (held there, headsq's first round ended at 0.129 instead of 0.203).
     rounds.shape_options.rank_guard = std::max(rounds.shape_options.rank_guard, kQuestionableSJ);
+  }
+  return released;
+}
+
+}  // namespace
+
+nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& o,
+                              std::size_t* reattached) {
+  const Incidence inc = vertex_hexes(mesh);
+  const BoundarySurface start = surface;
+  RoundJournal journal(mesh.points.size());
+  RoundScore score;
+  nlohmann::json released = rounds_in_band(mesh, surface, band, o, inc, score, journal);
+  // Rounds that end with hexes invalid (inverted, or not valid inside) run once more from
+  // where they began, in a band 5/3 as wide (0.3 -> 0.5 cells by default): the band decides
+  // their path, and validity outranks its reach. cthead at iso 1000 (skin to bone), h 3, kept
+  // two pillow hexes at -0.0002 through five rounds in a band of 0.3 cells and ended with none
+  // below 0.2 in 0.5; widening the band about those hexes alone, in later rounds, left them
+  // at 0 (not valid inside). The better of the two runs (RoundScore) is kept.
+  if (score.min_sj <= 0) {
+    const double wider = band * 5 / 3;
+    fmt::print("boundary: the rounds left hexes invalid (min SJ {:.4f}); again from their start in a band of {:.3g}\n",
+               score.min_sj, wider);
+    const std::vector<Vec3> first = journal.places(mesh);
+    const BoundarySurface first_surface = surface;
+    journal.restore(mesh);
+    surface = start;
+    RoundScore again;
+    RoundJournal second(mesh.points.size());
+    nlohmann::json retry = rounds_in_band(mesh, surface, wider, o, inc, again, second);
+    if (again.worse_than(score)) {
+      second.restore(mesh);  // back to the rounds' start, then the first run's places
+      journal.put(mesh, first);
+      surface = first_surface;
+      fmt::print("boundary: the wider band did no better ({} below 0.2, min SJ {:.4f}); the first run kept\n",
+                 again.below, again.min_sj);
+      released.push_back({{"retried_band", wider}, {"rounds", retry}, {"kept", false}});
+    } else {
+      retry.push_back({{"retried_band", wider}, {"first_rounds", released}, {"kept", true}});
+      released = std::move(retry);
+      band = wider;
+    }
   }
   // Released for the optimiser's sake, a vertex goes back onto its surface where the mesh now
   // allows it (cthead h 3: 354 of 1,979).
@@ -368,8 +439,9 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
   if (surface && slide.band > 0) first.untangle_options.rescues = 0;
   nlohmann::json j = run_optimisation(mesh, fixed, first);
   std::size_t reattached = 0;
+  double band = slide.band;  // wider if the rounds ran again (release_rounds())
   const nlohmann::json released =
-      surface && slide.band > 0 ? release_rounds(mesh, *surface, slide.band, o, &reattached) : nlohmann::json::array();
+      surface && band > 0 ? release_rounds(mesh, *surface, band, o, &reattached) : nlohmann::json::array();
   if (surface) {
     const auto [far, off] = surface->fit(mesh);
     nlohmann::json per = nlohmann::json::object();
@@ -380,7 +452,8 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
                      {"sliding_per_surface", per},
                      {"pinned", surface->num_pinned()},
                      {"max_relative_level", far},
-                     {"band", slide.band},
+                     {"band", band},
+                     {"band_asked", slide.band},
                      {"loose", surface->num_loose()},
                      {"reattached", reattached},
                      {"max_loose_distance", off},
@@ -391,7 +464,7 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
     }
     if (surface->num_loose() > 0)
       fmt::print("boundary: {} vertices within {:.3g} of their surface (band {:.3g}); the other {} on it\n",
-                 surface->num_loose(), off, slide.band, surface->num_sliding());
+                 surface->num_loose(), off, band, surface->num_sliding());
   } else {
     j["boundary"] = {{"mode", "fixed"}};
   }

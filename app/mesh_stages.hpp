@@ -57,8 +57,10 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 /// units) about their surface (BoundarySurface::loosen) and optimise again within 3 hex rings
 /// of those hexes. Returns each round's JSON facts (with "released": vertices released).
 /// Ends by putting released vertices back on their surface where the hexes allow it
-/// (reattach_released()); how many, into `reattached` (may be null).
-nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double band, const OptimizeOptions& options,
+/// (reattach_released()); how many, into `reattached` (may be null). Rounds that leave hexes
+/// invalid run once more from their start in a band 5/3 as wide, and the better run is kept
+/// (`band` then holds the wider band).
+nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& options,
                               std::size_t* reattached = nullptr);
 
 /// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
