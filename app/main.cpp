@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <malloc.h>
 #include <exception>
 
 namespace isohex::cli {
@@ -16,6 +17,10 @@ int& exit_code() {
 }  // namespace isohex::cli
 
 int main(int argc, char** argv) {
+  // Arrays of 1 MiB and more always mapped apart and returned when freed: glibc's threshold
+  // otherwise rises each time such an array is freed, later ones come from the heap, and its
+  // high-water mark stays (cthead h 2's peak 168 -> 161 MiB, the same time).
+  mallopt(M_MMAP_THRESHOLD, 1 << 20);
   CLI::App app{"isohex: all-hexahedral meshes from volumes, with verified element quality"};
   app.set_version_flag("--version", "isohex 0.1.0");
   app.require_subcommand(1);

@@ -289,7 +289,7 @@ nlohmann::json rounds_in_band(HexMesh& mesh, BoundarySurface& surface, double ba
     // When the reach of this round releases nothing new (all of it is loose already and a
     // hex is still below: cthead h 4 stopped at 0.182 in a pillow hex), it grows by a ring.
     std::vector<Index> candidates;
-    const BoundarySurface saved = surface;
+    const BoundarySurface::Roles saved = surface.roles();
     std::size_t n = 0;
     ReleaseRings rings(mesh, inc, sj);
     if (round > 1) rings.grow();
@@ -318,7 +318,7 @@ nlohmann::json rounds_in_band(HexMesh& mesh, BoundarySurface& surface, double ba
       fmt::print("boundary: round {} left the mesh worse ({} below 0.2, min SJ {:.4f}; before it {}, {:.4f}); "
                  "again without the shape stage\n", round, after.below, after.min_sj, score.below, score.min_sj);
       points.restore(mesh);
-      surface = saved;
+      surface.set_roles(saved);
       surface.loosen(mesh, candidates, band);
       rounds.shape_options.max_iter = 0;
       again["retried"] = run_optimisation(mesh, held, rounds);
@@ -326,7 +326,7 @@ nlohmann::json rounds_in_band(HexMesh& mesh, BoundarySurface& surface, double ba
     }
     if (after.worse_than(score)) {
       points.restore(mesh);
-      surface = saved;
+      surface.set_roles(saved);
       fmt::print("boundary: round {} undone ({} below 0.2, min SJ {:.4f}; before it {}, {:.4f})\n", round, after.below,
                  after.min_sj, score.below, score.min_sj);
       again["undone"] = true;
@@ -351,7 +351,7 @@ nlohmann::json rounds_in_band(HexMesh& mesh, BoundarySurface& surface, double ba
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& o,
                               std::size_t* reattached) {
   const Incidence inc = vertex_hexes(mesh);
-  const BoundarySurface start = surface;
+  const BoundarySurface::Roles start = surface.roles();
   RoundJournal journal(mesh.points.size());
   RoundScore score;
   nlohmann::json released = rounds_in_band(mesh, surface, band, o, inc, score, journal);
@@ -366,16 +366,16 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& b
     fmt::print("boundary: the rounds left hexes invalid (min SJ {:.4f}); again from their start in a band of {:.3g}\n",
                score.min_sj, wider);
     const std::vector<Vec3> first = journal.places(mesh);
-    const BoundarySurface first_surface = surface;
+    BoundarySurface::Roles first_roles = surface.roles();
     journal.restore(mesh);
-    surface = start;
+    surface.set_roles(start);
     RoundScore again;
     RoundJournal second(mesh.points.size());
     nlohmann::json retry = rounds_in_band(mesh, surface, wider, o, inc, again, second);
     if (again.worse_than(score)) {
       second.restore(mesh);  // back to the rounds' start, then the first run's places
       journal.put(mesh, first);
-      surface = first_surface;
+      surface.set_roles(std::move(first_roles));
       fmt::print("boundary: the wider band did no better ({} below 0.2, min SJ {:.4f}); the first run kept\n",
                  again.below, again.min_sj);
       released.push_back({{"retried_band", wider}, {"rounds", retry}, {"kept", false}});

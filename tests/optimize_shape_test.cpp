@@ -86,6 +86,48 @@ TEST(OptimizeShape, DerivativesMatchFiniteDifferences) {
             1e-6);
 }
 
+// The line search's model of a vertex's energy (model_energy()) against the energy itself
+// (vertex_energy()) at displaced places: the same to rounding for the shape energy (with its
+// barrier: +inf exactly where the hexes' frames fold), the untangler's, and the untangler's
+// with interior frames and Bernstein coefficients; recorded only with a gradient.
+TEST(OptimizeShape, TermModelMatchesTheEnergy) {
+  HexMesh m = jittered_box(3, 0.3, 11);
+  const Index v = 1 + 4 + 16;
+  const Incidence inc = vertex_hexes(m);
+  const std::vector<double> il = opt::inverse_edge_lengths(m);
+  const std::vector<std::uint8_t> all(m.hexes.size(), 1);
+  opt::EnergyParams full{true, 0.05, 0.5};
+  full.interior = full.bernstein = &all;
+  std::vector<opt::TermModel> model;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double len = 1.0 / 3;
+  for (const opt::EnergyParams& p : {opt::EnergyParams{}, opt::EnergyParams{true, 0.3, 0.5}, full}) {
+    Vec3 g;
+    opt::Mat3 H;
+    const Vec3 x = m.points[v];
+    const double e0 = opt::vertex_energy(m, inc, il, v, x, p, &g, &H, &model);
+    ASSERT_FALSE(model.empty());
+    EXPECT_NEAR(opt::model_energy(model, Vec3::Zero(), p.lambda), e0, 1e-13 * e0);
+    int infinite = 0;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 d = len * (i < 100 ? 0.2 : 1.0) * Vec3(u(rng), u(rng), u(rng));
+      const double e = opt::vertex_energy(m, inc, il, v, x + d, p);
+      const double em = opt::model_energy(model, d, p.lambda);
+      if (!std::isfinite(e)) {
+        ++infinite;
+        EXPECT_FALSE(std::isfinite(em)) << i;
+      } else {
+        EXPECT_NEAR(em, e, 1e-10 * e) << i;
+      }
+    }
+    if (!p.untangle) EXPECT_GT(infinite, 0);  // the far steps do fold hexes: the barrier is seen
+  }
+  const std::size_t before = model.size();
+  opt::vertex_energy(m, inc, il, v, m.points[v], full, nullptr, nullptr, &model);
+  EXPECT_EQ(model.size(), before);  // no gradient asked: nothing recorded
+}
+
 // The energies' x^(−1/3) against long double's cbrtl over the normal doubles: within 2 ulp
 // (the Newton steps square the error of a start from the bits; a wrong start constant or one
 // step fewer leaves errors far above that), and glibc's answer for what it does not take.

@@ -111,8 +111,7 @@ struct Scalar {
   return r;
 }
 
-[[gnu::always_inline]] inline Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
-  const double F = A.squaredNorm(), D = A.determinant();
+[[gnu::always_inline]] inline Scalar term(double F, double D, int t, const EnergyParams& params, double eps) {
   if (params.untangle) return untangle_term(F, D, eps, params.lambda);
   if (t >= kCentreFrame) {  // the centre and interior frames only constrain (validity), they are not optimised
     Scalar r;
@@ -122,13 +121,17 @@ struct Scalar {
   return shape_term(F, D);
 }
 
+[[gnu::always_inline]] inline Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
+  return term(A.squaredNorm(), A.determinant(), t, params, eps);
+}
+
 // The Bernstein coefficients of det J of the hex p (at the frames' scale inv_len³) that are
 // not corner values (those are frames already), as the energy's extra terms: each coefficient
 // is affine in one vertex's place (every lattice determinant is, by the matrix determinant
 // lemma, and the coefficients are fixed combinations of them), so its term's Hessian is
 // f''(b) ∇b ∇bᵀ. With `g`, the gradient and Hessian in corner k's place are added.
 double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, const EnergyParams& params, double eps,
-                        Vec3* g, Mat3* H);
+                        Vec3* g, Mat3* H, std::vector<TermModel>* model = nullptr);
 
 }  // namespace
 
@@ -158,7 +161,7 @@ const std::array<int, 27>& lattice_frames() {
 namespace {
 
 double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, const EnergyParams& params, double eps,
-                        Vec3* g, Mat3* H) {
+                        Vec3* g, Mat3* H, std::vector<TermModel>* model) {
   const std::array<int, 27>& lattice = lattice_frames();
   std::array<double, 27> b, gx, gy, gz;  // values and gradients, transformed alike
   for (int n = 0; n < 27; ++n) {
@@ -184,6 +187,7 @@ double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, con
     e += s.f;
     if (!g) continue;
     const Vec3 gb(gx[n], gy[n], gz[n]);
+    if (model) model->push_back({0, b[n], 0, eps, Vec3::Zero(), gb, TermModel::Kind::bernstein});
     *g += s.fD * gb;
     if (H) *H += s.fDD * (gb * gb.transpose());
   }
@@ -325,8 +329,10 @@ const std::array<std::array<CoefKind, 8>, kAllFrames> kKinds = [] {
 }  // namespace
 
 double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
-                     const Vec3& x, const EnergyParams& params, Vec3* g, Mat3* H) {
+                     const Vec3& x, const EnergyParams& params, Vec3* g, Mat3* H, std::vector<TermModel>* model) {
   double e = 0;
+  if (!g) model = nullptr;
+  if (model) model->clear();
   if (g) g->setZero();
   if (H) H->setZero();
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
@@ -343,14 +349,21 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     // a corner frame stays in registers: merged through memory, its reload after the stores
     // stalled (a tenth of the function's samples).
     const auto visit = [&](const Mat3& A, int t, CoefKind kind) __attribute__((always_inline)) {
-      const Scalar s = term(A, t, params, eps);
+      const double F = A.squaredNorm(), D = A.determinant();
+      const Scalar s = term(F, D, t, params, eps);
       e += s.f;
       if (!std::isfinite(e)) return false;
       // The shape stage's centre and interior frames only constrain: no derivatives.
-      if (!g || (!params.untangle && t >= kCentreFrame)) return true;
+      const bool constraint = !params.untangle && t >= kCentreFrame;
+      if (!g || (constraint && !model)) return true;
       const Vec3& c = kCoef[t][k];
       Vec3 gF, gD;
       frame_gradients(A, c, kind, il, gF, gD);
+      if (model)
+        model->push_back({F, D, il * il * c.squaredNorm(), eps, gF, gD,
+                          params.untangle ? TermModel::Kind::untangle
+                                          : constraint ? TermModel::Kind::constraint : TermModel::Kind::shape});
+      if (constraint) return true;
       *g += s.fF * gF + s.fD * gD;
       if (H) {
         *H += (s.fF * 2 * il * il * c.squaredNorm()) * Mat3::Identity();
@@ -366,9 +379,27 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
       if (!(t < 8 ? visit(corner_frame(p, t, il), t, kind) : visit(frame(p, t, il), t, kind))) return kInf;
     }
     if (params.bernstein_of(h)) {
-      e += bernstein_energy(p, k, il, params, eps, g, H);
+      e += bernstein_energy(p, k, il, params, eps, g, H, model);
       if (!std::isfinite(e)) return kInf;
     }
+  }
+  return e;
+}
+
+double model_energy(const std::vector<TermModel>& model, const Vec3& d, double lambda) {
+  const double dd = d.squaredNorm();
+  double e = 0;
+  for (const TermModel& m : model) {
+    const double D = m.D0 + m.gD.dot(d);
+    switch (m.kind) {
+      case TermModel::Kind::shape: e += shape_term(m.F0 + m.gF.dot(d) + m.cc * dd, D).f; break;
+      case TermModel::Kind::constraint:
+        if (!(D > kMinFeasibleDet)) return kInf;
+        break;
+      case TermModel::Kind::untangle: e += untangle_term(m.F0 + m.gF.dot(d) + m.cc * dd, D, m.eps, lambda).f; break;
+      case TermModel::Kind::bernstein: e += untangle_term(0, D, m.eps, lambda).f; break;
+    }
+    if (!std::isfinite(e)) return kInf;
   }
   return e;
 }
@@ -378,7 +409,8 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   Move m{mesh.points[v], 0, false, 0};
   Vec3 g;
   Mat3 H;
-  const double e0 = vertex_energy(mesh, inc, inv_len, v, m.x, params, &g, &H);
+  thread_local std::vector<TermModel> model;  // the trials' energy (a buffer per thread, as below)
+  const double e0 = vertex_energy(mesh, inc, inv_len, v, m.x, params, &g, &H, &model);
   if (!std::isfinite(e0) || inc.count(v) == 0) return m;
   const double len = vertex_length(inc, inv_len, v);
   m.grad = g.norm() * len;
@@ -447,7 +479,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   for (int i = 0; i < 30 && t * dn >= shortest; ++i, t *= 0.5) {
     Vec3 x = m.x + t * d;
     if (params.surface && !params.surface->put_back(v, x, n, len)) continue;
-    const double e = vertex_energy(mesh, inc, inv_len, v, x, params);
+    const double e = model_energy(model, x - m.x, params.lambda);
     ++m.trials;
     // The shape stage's barrier sees the 9 frames only: a step must also keep every hex
     // around v certified valid inside (hex_feasible()), or a fold could open between them.

@@ -180,11 +180,28 @@ inline double hex_rank(const CertifiedQuality& c) {
 /// of 0.1 is poor, kPoorJacobianRatio; the bound is at most the ratio).
 inline constexpr double kShapeRatioFloor = 0.1;
 
+/// One term of a vertex's energy as a function of the vertex's displacement d from where it
+/// was recorded: the frame changes by the rank-one il·d·cᵀ, so its F = |A|² is F0 + gF·d +
+/// cc·|d|² and its D = det A is D0 + gD·d, exactly (a Bernstein coefficient is affine alike).
+/// A line search's trial then costs a few products per term instead of rebuilding the frames
+/// from the corners (the untangler's searches on cthead took 2.1 trials a move, some 15).
+struct TermModel {
+  enum class Kind : std::uint8_t { shape, constraint, untangle, bernstein };
+  double F0 = 0, D0 = 0, cc = 0, eps = 0;
+  Vec3 gF = Vec3::Zero(), gD = Vec3::Zero();
+  Kind kind = Kind::shape;
+};
+/// The energy of the recorded terms at displacement d: what vertex_energy() gives at x + d up
+/// to rounding (+inf where a barrier term's D is at most kMinFeasibleDet).
+double model_energy(const std::vector<TermModel>& model, const Vec3& d, double lambda);
+
 /// The energy of the hexes around vertex v with v placed at x; with g and H, also its gradient
 /// and Hessian with respect to x (the Hessian of the regularised energy may be indefinite).
-/// +inf if the shape stage would make a hex infeasible.
+/// +inf if the shape stage would make a hex infeasible. With `model` (and g), each term is also
+/// recorded as a function of v's displacement from x, for model_energy().
 double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
-                     const Vec3& x, const EnergyParams& params, Vec3* g = nullptr, Mat3* H = nullptr);
+                     const Vec3& x, const EnergyParams& params, Vec3* g = nullptr, Mat3* H = nullptr,
+                     std::vector<TermModel>* model = nullptr);
 
 /// One Newton step of vertex v with a backtracking (Armijo) line search; returns the new
 /// position (the old one if no step lowered the energy) and the scaled gradient norm |g|·L.

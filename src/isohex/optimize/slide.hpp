@@ -118,6 +118,20 @@ class BoundarySurface {
   }
 
   [[nodiscard]] Role role(Index v) const { return static_cast<Role>(role_[v]); }
+  /// What loosen() and reattach() change (each vertex's role and target, the band), to be put
+  /// back with set_roles(): a few bytes a vertex, where a copy of the whole surface would
+  /// carry its triangles and grid too.
+  struct Roles {
+    std::vector<std::uint8_t> role, unpinned;
+    std::vector<std::int8_t> target;
+    std::size_t sliding = 0, pinned = 0, loose = 0;
+    double band = 0;
+  };
+  [[nodiscard]] Roles roles() const { return {role_, unpinned_, target_, sliding_, pinned_, loose_, band_}; }
+  void set_roles(Roles r) {
+    role_ = std::move(r.role), unpinned_ = std::move(r.unpinned), target_ = std::move(r.target);
+    sliding_ = r.sliding, pinned_ = r.pinned, loose_ = r.loose, band_ = r.band;
+  }
   [[nodiscard]] std::size_t num_sliding() const { return sliding_; }
   [[nodiscard]] std::size_t num_pinned() const { return pinned_; }
   /// The vertices the optimisers must hold: the pinned ones.
