@@ -326,6 +326,35 @@ TEST(MeshCli, RoundsLeftInvalidRunAgainInAWiderBand) {
   EXPECT_GT(released_within_band(m, f, Vec3(255, 255, 224), 1.5), 0u);
 }
 
+// A crop of cthead whose box cuts thin bone at iso 1000 (voxels 72-107, 44-79, 65-82): the
+// extraction's projection of a box-face vertex onto the isosurface within its face walked
+// past the domain's edge (z = -0.27 on the face x = 35), where sliding could never bring it
+// back, and the run exited 1. Now it passes with every vertex in the domain.
+TEST(MeshCli, BoxFaceVerticesStayInTheDomain) {
+  ISOHEX_REQUIRE_SHARED_DATA();
+  const auto dir = scratch_dir();
+  const std::string all = io::read_file(isohex::test::shared_data("volumes/cthead_256x256x113_int16be.raw"));
+  ASSERT_EQ(all.size(), 256u * 256u * 113u * 2u);
+  std::string crop;
+  for (std::size_t z = 65; z < 83; ++z)
+    for (std::size_t y = 44; y < 80; ++y) crop += all.substr(2 * ((z * 256 + y) * 256 + 72), 2 * 36);
+  io::write_atomically(dir / "crop.raw", [&](std::ostream& o) { o << crop; });
+  std::string out;
+  ASSERT_EQ(run_cli("mesh " + q(dir / "crop.raw") +
+                        " --dims 36 36 18 --type i16 --endian big --spacing 1 1 2 --iso 1000 --cell-size 3 -o " +
+                        q(dir / "m.vtu") + " --json " + q(dir / "m.json"),
+                    &out),
+            0)
+      << out;
+  const auto m = nlohmann::json::parse(io::read_file(dir / "m.json"));
+  EXPECT_GT(m["box_vertices"].get<int>(), 0);
+  EXPECT_EQ(m["outside_domain_vertices"], 0);
+  EXPECT_EQ(m["validity"]["not_valid_inside"], 0);
+  // Independently: every vertex of the written mesh within [0, 35] x [0, 35] x [0, 34].
+  for (const Vec3& p : io::read_mesh(dir / "m.vtu").points)
+    EXPECT_TRUE(p.minCoeff() >= 0 && p.x() <= 35 && p.y() <= 35 && p.z() <= 34) << p.transpose();
+}
+
 // Runs `base -o DIR/NAME.vtu --json DIR/NAME.json` (must succeed) and returns the report.
 namespace {
 nlohmann::json mesh_report(const std::string& base, const std::filesystem::path& dir, const std::string& name) {

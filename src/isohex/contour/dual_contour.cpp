@@ -177,9 +177,14 @@ Placement place_vertex(const Region& region, const SampledGrid& g, std::size_t i
   if (box_axes) {
     for (int a = 0; a < 3; ++a)
       if (box_axes & (1u << a)) x[a] = box_point[a];
+    // The projection keeps the box axes but may walk the others past the domain's edge (a crop
+    // of cthead at iso 1000 had a vertex of its face x = 35 at z = -0.27, outside for good:
+    // sliding refuses to leave the box, not to come back): then the vertex stays in its cell.
     if (surface >= 0) {
       Vec3 y = x;
-      if (project_within_faces(region.surfaces[static_cast<std::size_t>(surface)], y, box_axes, h)) x = y;
+      if (project_within_faces(region.surfaces[static_cast<std::size_t>(surface)], y, box_axes, h) &&
+          region.domain.contains(y))
+        x = y;
     }
     return {x, kBoxVertex, false};
   }
