@@ -235,29 +235,21 @@ class ReleaseRings {
 // them again needs, without a copy of every point (cthead h 2: 15 MiB).
 class RoundJournal {
  public:
-  explicit RoundJournal(std::size_t vertices) : noted_(vertices, 0) {}
+  explicit RoundJournal(std::size_t vertices) : unmoved_(vertices, 1) {}
   /// Before a round that moves the vertices not `held`.
   void note(const HexMesh& mesh, const std::vector<std::uint8_t>& held) {
     for (std::size_t v = 0; v < held.size(); ++v)
-      if (!held[v] && !noted_[v]) noted_[v] = 1, ids_.push_back(static_cast<Index>(v)), at_.push_back(mesh.points[v]);
+      if (!held[v] && unmoved_[v]) unmoved_[v] = 0, ids_.push_back(static_cast<Index>(v)), at_.push_back(mesh.points[v]);
   }
   /// Every noted vertex back where it was.
   void restore(HexMesh& mesh) const {
     for (std::size_t i = 0; i < ids_.size(); ++i) mesh.points[ids_[i]] = at_[i];
   }
-  /// The places now of the noted vertices (to put back after another run's restore()).
-  [[nodiscard]] std::vector<Vec3> places(const HexMesh& mesh) const {
-    std::vector<Vec3> p;
-    p.reserve(ids_.size());
-    for (Index v : ids_) p.push_back(mesh.points[v]);
-    return p;
-  }
-  void put(HexMesh& mesh, const std::vector<Vec3>& places) const {
-    for (std::size_t i = 0; i < ids_.size(); ++i) mesh.points[ids_[i]] = places[i];
-  }
+  /// 1 for the vertices no round has moved (a PointSnapshot of the others holds the rounds' result).
+  [[nodiscard]] const std::vector<std::uint8_t>& unmoved() const { return unmoved_; }
 
  private:
-  std::vector<std::uint8_t> noted_;
+  std::vector<std::uint8_t> unmoved_;
   std::vector<Index> ids_;
   std::vector<Vec3> at_;
 };
@@ -365,7 +357,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& b
     const double wider = band * 5 / 3;
     fmt::print("boundary: the rounds left hexes invalid (min SJ {:.4f}); again from their start in a band of {:.3g}\n",
                score.min_sj, wider);
-    const std::vector<Vec3> first = journal.places(mesh);
+    const PointSnapshot first(mesh, journal.unmoved());
     BoundarySurface::Roles first_roles = surface.roles();
     journal.restore(mesh);
     surface.set_roles(start);
@@ -374,7 +366,7 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& b
     nlohmann::json retry = rounds_in_band(mesh, surface, wider, o, inc, again, second);
     if (again.worse_than(score)) {
       second.restore(mesh);  // back to the rounds' start, then the first run's places
-      journal.put(mesh, first);
+      first.restore(mesh);
       surface.set_roles(std::move(first_roles));
       fmt::print("boundary: the wider band did no better ({} below 0.2, min SJ {:.4f}); the first run kept\n",
                  again.below, again.min_sj);
