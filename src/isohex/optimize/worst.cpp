@@ -3,8 +3,10 @@
 #include "isohex/optimize/feasibility.hpp"
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
+#include "isohex/optimize/ordered_moves.hpp"
 #include "isohex/optimize/patch.hpp"
 #include "isohex/optimize/search.hpp"
+#include "isohex/optimize/worst_move.hpp"
 #include "isohex/optimize/slide.hpp"
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/jacobian_bounds.hpp"
@@ -22,13 +24,6 @@
 namespace isohex {
 
 namespace {
-
-// Degenerate (collapsed) hexes rank below every real value; a hex that is not certified valid
-// inside counts as 0 at best, whatever its nine samples say.
-double sj_value(const std::array<Vec3, 8>& p) {
-  const double v = certified_scaled_jacobian(p);
-  return is_degenerate(v) ? -2.0 : v;
-}
 
 // The vertices of the lowest of a hex's nine scaled-Jacobian frames: a corner and its three
 // neighbours, or all eight for the centre frame.
@@ -67,231 +62,6 @@ std::vector<Index> frame_star(const HexMesh& mesh, const Incidence& inc, const s
   return around;
 }
 
-// The lowest scaled Jacobian of the hexes around v with v placed at x. With `valid`, also
-// whether every hex that is valid now (scaled Jacobian > 0) stays valid there and no edge at
-// v is shorter than `shrink` times its length in `start` (the mesh when the pass began): the
-// scaled Jacobian is blind to edge lengths, so a max–min ascent alone may shrink an edge
-// towards zero (on a sphere's mesh it drove the mean inverse mean ratio from 1.3 to 81).
-// With `ratio`, also the smallest jacobian_ratio_bound() of those hexes: the scaled Jacobian
-// samples det J at nine points, so the pass must not buy them with a distorted interior.
-// With `edges`, also the largest edge ratio of those hexes.
-double local_min(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool* valid = nullptr,
-                 int* questionable = nullptr, const std::vector<Vec3>* start = nullptr, double shrink = 0,
-                 double* ratio = nullptr, double* edges = nullptr) {
-  double lo = 2.0;
-  if (valid) *valid = true;
-  if (questionable) *questionable = 0;
-  if (ratio) *ratio = 1.0;
-  if (edges) *edges = 1.0;
-  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
-    const Index h = inc.ids[i];
-    const auto p = opt::corners_with(mesh, h, v, x);
-    double q;
-    if (ratio) {  // both from one evaluation of the hex's Bernstein coefficients
-      const CertifiedQuality c = certified_quality(p);
-      q = is_degenerate(c.scaled_jacobian) ? -2.0 : c.scaled_jacobian;
-      *ratio = std::min(*ratio, c.ratio_bound);
-    } else {
-      q = sj_value(p);
-    }
-    lo = std::min(lo, q);
-    if (questionable) *questionable += q < kQuestionableSJ;
-    if (edges) *edges = std::max(*edges, edge_ratio(p));  // Verdict's, as `isohex quality` reports it
-    if (!valid) continue;
-    if (q <= 0 && sj_value(mesh.corners(h)) > 0) *valid = false;
-    for (const auto& e : kHexEdges) {
-      const Index a = mesh.hexes[h][e[0]], b = mesh.hexes[h][e[1]];
-      if (start && (a == v || b == v) &&
-          (p[e[0]] - p[e[1]]).squaredNorm() < shrink * shrink * ((*start)[a] - (*start)[b]).squaredNorm())
-        *valid = false;
-    }
-  }
-  return lo;
-}
-
-using opt::kRatioWeight;
-
-// The largest Bernstein coefficient of det J of each hex around v as the mesh stands (in
-// incidence order; 0 for a hex with none positive): the ratio terms' constant normalisation
-// during one move of v.
-std::vector<double> ratio_norms(const HexMesh& mesh, const Incidence& inc, Index v) {
-  std::vector<double> m;
-  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) m.push_back(opt::bernstein_norm(mesh.corners(inc.ids[i])));
-  return m;
-}
-
-// The Bernstein coefficients of det J of each hex around v over its norm, as affine functions
-// of v's place (opt::ratio_coefficients). Their minimum bounds the hex's jacobian ratio from
-// below, so a max–min move on them raises the element's interior, not only Verdict's nine
-// samples.
-void ratio_terms(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool value_only,
-                 const std::vector<double>& norms, std::vector<opt::Affine>& out) {
-  std::array<double, 27> b;
-  std::array<std::array<Vec3, 27>, 8> g;
-  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
-    const double m = norms[static_cast<std::size_t>(i - inc.offsets[v])];
-    if (!(m > 0)) continue;
-    const Index h = inc.ids[i];
-    auto p = mesh.corners(h);
-    int k = 0;
-    while (mesh.hexes[h][k] != v) ++k;
-    p[k] = x;
-    std::array<bool, 8> corner{};
-    corner[k] = true;
-    opt::ratio_coefficients(p, kRatioWeight, m, corner, b, value_only ? nullptr : &g);
-    for (int n = 0; n < 27; ++n) out.push_back({value_only ? Vec3::Zero() : g[k][n], b[n]});
-  }
-}
-
-// The scaled Jacobians of the frames (of the hexes around v) that v's position changes, each
-// as its value and gradient in that position (opt::scaled_frame). Verdict's hex value is the
-// minimum of these and of the frames v is not in. With `value_only`, the gradients are left
-// zero; with `norms` (ratio_norms()), ratio_terms() come too.
-std::vector<opt::Affine> frame_values(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x,
-                                      bool value_only, const std::vector<double>* norms) {
-  std::vector<opt::Affine> out;
-  if (norms) ratio_terms(mesh, inc, v, x, value_only, *norms, out);
-  for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
-    const Index h = inc.ids[i];
-    auto p = mesh.corners(h);
-    int k = 0;
-    while (mesh.hexes[h][k] != v) ++k;
-    p[k] = x;
-    for (int t = 0; t < opt::kFrames; ++t) {
-      const Vec3& c = opt::frame_coefficient(t, k);
-      if (!c.isZero()) out.push_back(opt::scaled_frame(opt::frame(p, t, 1.0), c, value_only));
-    }
-  }
-  return out;
-}
-
-double lowest(const std::vector<opt::Affine>& f) {
-  double lo = 2.0;
-  for (const opt::Affine& a : f) lo = std::min(lo, a.b);
-  return lo;
-}
-
-// A max–min move of v: at its current place, the frame values v changes are linearised and
-// the LP max_min_affine() finds the step within a trust box that maximises their smallest
-// (a first-order model of a nonsmooth max–min, which a single gradient misses where two
-// frames tie: following either one lowers the other). The box halves until the true values
-// confirm a gain, and the model is rebuilt at the new place a few times. A step is taken only
-// if the smallest of those frame values rises, Verdict's minimum around v does not fall, no
-// valid hex is inverted and no more hexes around v fall below 0.2; so the mesh minimum never
-// falls. A sliding vertex steps in its tangent plane and is put back on its surface.
-//
-// With the ratio terms, the smallest value is often a ratio term that no move of v alone can
-// raise (a cluster of pillow hexes with ratios 0.07-0.08 at a convex tip of cthead h 4), and a
-// scaled Jacobian below 0.2 beside it was left as it was. A second phase then raises the
-// scaled-Jacobian frames alone with the ratio terms held as constraints: none falls below the
-// smallest of them now, and the certified ratio around v does not fall either.
-bool move_vertex(HexMesh& mesh, const Incidence& inc, Index v, const std::vector<Vec3>& start,
-                 const BoundarySurface* surface, const WorstOptions& options, double mesh_min) {
-  const Vec3 x0 = mesh.points[v];
-  int below0 = 0;
-  double ratio0 = 1;
-  double edges0 = 1;
-  const double m0 = local_min(mesh, inc, v, x0, nullptr, &below0, nullptr, 0, &ratio0, &edges0);
-  // Raising a ratio below the floor (0.1) outranks the edge-ratio aim: such a vertex may go
-  // up to the limit instead.
-  const double edge_cap =
-      std::max(edges0, options.ratio_terms && ratio0 < kPoorJacobianRatio ? options.poor_ratio_edge_limit
-                                                                          : options.max_edge_ratio);
-  const double ratio_floor = std::min(ratio0, options.ratio_floor);
-  // With the ratio terms, the scaled Jacobian around v may fall to buy a ratio, but not below
-  // the higher of sj_floor and the mesh minimum (so that never falls); without them it holds.
-  const double sj_floor = options.ratio_terms ? std::min(m0, std::max(options.sj_floor, mesh_min)) : m0;
-  const std::vector<double> norms = options.ratio_terms ? ratio_norms(mesh, inc, v) : std::vector<double>{};
-  const std::vector<double>* ratio = options.ratio_terms ? &norms : nullptr;
-  const double len = opt::mean_edge_at(mesh, inc, v);
-  if (!(len > 0)) return false;
-  const bool slides = surface && surface->role(v) == BoundarySurface::Role::slides;
-  Vec3 x = x0;
-  bool moved = false;
-  // Phase 2's constraint level: the smallest ratio term where it starts (NaN in phase 1).
-  double held_ratio = std::numeric_limits<double>::quiet_NaN();
-  // The terms of the model at y: the frames (and in phase 1 the ratio terms) to raise, as
-  // weight-1 terms; in phase 2 the ratio terms as constraints, offset by held_ratio and
-  // weighted almost 0 (f >= s·w is then f >= held_ratio, nearly).
-  struct Model {
-    std::vector<opt::Affine> f;
-    std::vector<double> w;
-    double now;          // the smallest term to raise
-    std::size_t raised;  // the terms to raise come first; the constraints follow them
-  };
-  const auto terms = [&](const Vec3& y, bool value_only) {
-    Model m{frame_values(mesh, inc, v, y, value_only, std::isnan(held_ratio) ? ratio : nullptr), {}, 0, 0};
-    m.now = lowest(m.f);
-    m.raised = m.f.size();
-    m.w.assign(m.f.size(), 1.0);
-    if (!std::isnan(held_ratio)) {
-      std::vector<opt::Affine> r;
-      ratio_terms(mesh, inc, v, y, value_only, norms, r);
-      for (opt::Affine& a : r) a.b -= held_ratio, m.f.push_back(a), m.w.push_back(1e-6);
-    }
-    return m;
-  };
-  for (int phase = 1; phase <= (options.ratio_terms ? 2 : 1); ++phase) {
-    if (phase == 2) {
-      std::vector<opt::Affine> r;
-      ratio_terms(mesh, inc, v, x, true, norms, r);
-      if (r.empty()) break;
-      held_ratio = lowest(r);
-    }
-    double box = options.step * len;
-    for (int model = 0; model < options.models; ++model) {
-      Model m = terms(x, false);
-      std::vector<opt::Affine>& f = m.f;
-      std::vector<double>& w = m.w;
-      const double now = m.now;
-      // Frames at the target are good enough: no move there, and the model seeks no more (a
-      // constant frame at the target caps the LP's bound), so the max–min step does not flatten
-      // the shape of hexes that need no help.
-      if (!(now < options.target)) break;
-      // Tangential steps of a sliding vertex: the LP's unknowns are coordinates in the tangent
-      // plane (the third has no effect and stays in the box).
-      Vec3 n = Vec3::Zero(), t1 = Vec3::UnitX(), t2 = Vec3::UnitY();
-      if (slides) {
-        if (!surface->tangent_normal(v, x, n)) break;
-        t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
-        t2 = n.cross(t1);
-        for (opt::Affine& a : f) a.a = Vec3(a.a.dot(t1), a.a.dot(t2), 0.0);
-      }
-      f.push_back({Vec3::Zero(), options.target});
-      w.push_back(1.0);
-      bool gained = false;
-      for (int trial = 0; trial < options.trials && !gained; ++trial, box *= 0.5) {
-        const opt::MaxMin r = opt::max_min_affine(f, w, box);
-        if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model: a max–min point
-        Vec3 y = slides ? Vec3(x + r.d[0] * t1 + r.d[1] * t2) : Vec3(x + r.d);
-        if (surface && !surface->put_back(v, y, n, len)) continue;  // off the surface (or band): refused
-        bool valid = false;
-        int below = 0;
-        double ratio_y = 1, edges_y = 1;
-        // A negative local minimum may rise while a valid neighbour is inverted on the way;
-        // raising one hex by bending several others below 0.2 is no gain.
-        const double q =
-            local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y, &edges_y);
-        if (!valid || below > below0 || q < sj_floor || ratio_y < ratio_floor || edges_y > edge_cap) continue;
-        const Model my = terms(y, true);
-        if (!(my.now > now + 1e-9)) continue;
-        // Phase 2: the ratio terms held, and the certified ratio around v too; the scaled
-        // Jacobian it raises may not fall.
-        if (phase == 2 && (ratio_y < ratio0 || q < m0 || std::any_of(my.f.begin() + static_cast<std::ptrdiff_t>(my.raised), my.f.end(),
-                                                           [](const opt::Affine& a) { return a.b < 0; })))
-          continue;
-        x = y;
-        gained = moved = true;
-      }
-      if (!gained) break;
-      box = std::min(4 * box, options.step * len);  // the box that worked, doubled (the loop halved it once more)
-    }
-  }
-  if (!moved) return false;
-  mesh.points[v] = x;
-  return true;
-}
-
 }  // namespace
 
 WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const WorstOptions& options) {
@@ -305,7 +75,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   const auto update = [&](Index h) {
     const auto p = mesh.corners(h);
     if (!options.ratio_terms) {
-      sj[h] = rank[h] = sj_value(p);
+      sj[h] = rank[h] = opt::worst_sj_value(p);
       return;
     }
     const CertifiedQuality c = certified_quality(p);
@@ -370,7 +140,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   };
   // A vertex whose move found no gain is not tried again until a vertex of a hex around it
   // moves (in a pass, a joint move or a walk) or the floor the move reads from the mesh
-  // minimum changes: move_vertex() reads nothing else, so skipping it gives the same mesh.
+  // minimum changes: opt::worst_move() reads nothing else, so skipping it gives the same mesh.
   // (Trying every vertex again at each new minimum and after each joint move was half of
   // cthead h 2's 200,000 tries, 94 us each.)
   std::vector<std::uint8_t> settled(mesh.points.size(), 0);
@@ -383,11 +153,117 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
     for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
       for (Index w : mesh.hexes[inc.ids[k]]) settled[w] = 0;
   };
-  // What move_vertex() reads of the mesh minimum: its scaled-Jacobian floor with the ratio
+  // What opt::worst_move() reads of the mesh minimum: its scaled-Jacobian floor with the ratio
   // terms, nothing without them.
   const auto floor_of = [&](double min_now) { return options.ratio_terms ? std::max(options.sj_floor, min_now) : 0.0; };
   using Clock = std::chrono::steady_clock;
   const auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  // One pass: the vertices of the hexes in `order` while a hex is among the `count` lowest
+  // below `below` or is below `raise_below` (by its rank when the pass reaches it), each moved
+  // once. It is one sequence of moves, run by OrderedMoves in windows: in parallel, with the
+  // sequence's result. A hex whose rank a move before it may have changed is checked once its
+  // window has run, by its rank with its vertices where they were at its turn; where it ends the
+  // pass, the moves after it are undone (their tries of settled vertices aside, which leave the
+  // mesh as it is). Returns the number of moves.
+  // Windows of 64 moves: a pass mostly ends at a hex that earlier moves raised (cthead h 4:
+  // after 20-35 % of the hexes it could reach), and a window's moves after that point are
+  // undone; with windows up to 1,024 moves as many were undone as kept.
+  constexpr std::size_t kWindow = 64;
+  opt::OrderedMoves moves(mesh, inc);
+  enum : std::uint8_t { kSkipped, kFailed, kMoved };
+  std::vector<std::uint8_t> outcome;
+  std::vector<Vec3> old;                              // per move: its vertex's place before it
+  std::vector<std::pair<std::uint8_t, double>> was;   // per failed move: its vertex's settled state before it
+  std::vector<std::uint64_t> was_at;                  // per moved vertex: its moved_at before it
+  struct Check {
+    std::size_t i, first;  // order[i], checked after the window's first `first` moves
+  };
+  std::vector<Check> checks;
+  const auto admits = [&](std::size_t i, double r) {
+    return (i < options.count && r < options.below) || r < options.raise_below;
+  };
+  const auto rank_then = [&](const Check& c) {  // order[c.i]'s rank when the sequence reached it
+    const Index h = order[c.i];
+    auto p = mesh.corners(h);
+    for (int j = 0; j < 8; ++j)
+      if (const Index k = moves.position(mesh.hexes[h][j]); k >= 0 && static_cast<std::size_t>(k) >= c.first)
+        p[j] = old[static_cast<std::size_t>(k)];
+    return options.ratio_terms ? opt::hex_rank(certified_quality(p)) : opt::worst_sj_value(p);
+  };
+  const auto one_pass = [&](double min_now, double floor_now) {
+    std::size_t moved = 0;
+    const auto undo_from = [&](std::size_t first) {
+      for (std::size_t k = moves.size(); k-- > first;) {
+        const Index v = moves.vertex(k);
+        if (outcome[k] == kMoved) mesh.points[v] = old[k], moved_at[v] = was_at[k], --moved;
+        if (outcome[k] == kFailed) settled[v] = was[k].first, settled_at[v] = was[k].second;
+      }
+      for (std::size_t k = first; k < moves.size(); ++k)
+        if (outcome[k] == kMoved)
+          for (Index n = inc.offsets[moves.vertex(k)]; n < inc.offsets[moves.vertex(k) + 1]; ++n) update(inc.ids[n]);
+    };
+    for (std::size_t i = 0;;) {
+      moves.clear();
+      checks.clear();
+      // A hex none of whose vertices has come yet has the rank it was sorted by; past the
+      // hexes that rank admits, one that may have changed is checked alone, after the moves
+      // before it.
+      bool last = false;
+      while (moves.size() < kWindow) {
+        if (!has(i)) { last = true; break; }
+        const Hex& hx = mesh.hexes[order[i]];
+        const bool changed = std::any_of(hx.begin(), hx.end(), [&](Index v) { return seen[v] == pass; });
+        if (!admits(i, sorted_rank[order[i]])) {
+          if (changed && (moves.size() > 0 || !checks.empty())) break;  // this window first
+          if (!changed || !admits(i, rank[order[i]])) { last = true; break; }
+        } else if (changed) {
+          checks.push_back({i, moves.size()});
+        }
+        for (Index v : hx) {
+          if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
+          seen[v] = pass;
+          // A settled vertex that no move before it can unsettle is no move at all.
+          const int level = moves.level_of(v);
+          if (level > 0 || !(settled[v] && settled_at[v] == floor_now)) moves.add(v, level);
+        }
+        ++i;
+      }
+      outcome.assign(moves.size(), kSkipped);
+      old.resize(moves.size());
+      was.resize(moves.size());
+      was_at.resize(moves.size());
+      moves.run(
+          [&](std::size_t k) {
+            const Index v = moves.vertex(k);
+            old[k] = mesh.points[v];
+            if (settled[v] && settled_at[v] == floor_now) return;
+            if (!opt::worst_move(mesh, inc, v, start, options.surface, options, min_now)) {
+              outcome[k] = kFailed;
+              return;
+            }
+            outcome[k] = kMoved;
+            // No other move of the level shares a hex with v: these entries are v's alone.
+            for (Index n = inc.offsets[v]; n < inc.offsets[v + 1]; ++n) update(inc.ids[n]);
+          },
+          [&](std::size_t k) {
+            const Index v = moves.vertex(k);
+            if (outcome[k] == kFailed) {
+              was[k] = {settled[v], settled_at[v]};
+              settled[v] = 1, settled_at[v] = floor_now;
+            } else if (outcome[k] == kMoved) {
+              was_at[k] = moved_at[v];
+              unsettle_around(v);
+              ++moved;
+            }
+          });
+      for (const Check& c : checks)
+        if (!admits(c.i, rank_then(c))) {
+          undo_from(c.first);
+          return moved;
+        }
+      if (last) return moved;
+    }
+  };
   const auto untimed_passes = [&](int passes, int stall_passes) {
     std::vector<Standing> history;
     for (int end = pass + passes; pass < end;) {
@@ -405,26 +281,9 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
                                               : now.tail < then.tail + options.stall_gain;
         if (stalled && now.min < then.min + options.stall_gain) break;
       }
-      // Sequential: deterministic, and cheap since only a few hundred vertices take part.
       ++pass;
-      std::size_t moved = 0;
-      const double min_now = mesh_min(), floor_now = floor_of(min_now);
-      for (std::size_t i = 0;
-           has(i) && ((i < options.count && rank[order[i]] < options.below) || rank[order[i]] < options.raise_below);
-           ++i) {
-        for (Index v : mesh.hexes[order[i]]) {
-          if ((!fixed.empty() && fixed[v]) || seen[v] == pass) continue;
-          seen[v] = pass;
-          if (settled[v] && settled_at[v] == floor_now) continue;
-          if (!move_vertex(mesh, inc, v, start, options.surface, options, min_now)) {
-            settled[v] = 1, settled_at[v] = floor_now;
-            continue;
-          }
-          unsettle_around(v);
-          ++moved;
-          for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) update(inc.ids[k]);
-        }
-      }
+      const double min_now = mesh_min();
+      const std::size_t moved = one_pass(min_now, floor_of(min_now));
       res.passes = pass;
       res.moves += moved;
       res.min_sj_after = mesh_min();

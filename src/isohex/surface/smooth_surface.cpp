@@ -153,6 +153,23 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
   std::vector<std::uint8_t> stale(mesh.points.size(), 1), active;
   std::vector<Vec3> normal, turned;
   std::vector<Index> work;
+  // A vertex whose search found nothing finds nothing again until a vertex it reads moves:
+  // raise_worst_quad() reads the quads of v and of its boundary neighbours, the turned flags
+  // of v's quads (the normals of their vertices: their quads' vertices for a box-face vertex)
+  // and with the hex guard the corners of v's hexes; all within two quad rings of v or in its
+  // hexes. So a move unsettles those of the mover, and a settled vertex is left as its search
+  // would leave it, in the same classes (the same mesh: on cthead h 2 most of the 40 passes'
+  // searches were repeats).
+  std::vector<std::uint8_t> settled(mesh.points.size(), 0);
+  const auto unsettle_around = [&](Index w) {
+    const auto& vq = ctx.graph.vertex_quads;
+    for (Index k = vq.offsets[w]; k < vq.offsets[w + 1]; ++k)
+      for (Index x : ctx.graph.quads[vq.ids[k]])
+        for (Index j = vq.offsets[x]; j < vq.offsets[x + 1]; ++j)
+          for (Index y : ctx.graph.quads[vq.ids[j]]) settled[y] = 0;
+    for (Index k = ctx.graph.vertex_hexes.offsets[w]; k < ctx.graph.vertex_hexes.offsets[w + 1]; ++k)
+      for (Index y : mesh.hexes[ctx.graph.vertex_hexes.ids[k]]) settled[y] = 0;
+  };
   for (int pass = 0; pass < options.worst_passes; ++pass) {
     surface_detail::update_normals(ctx, on_isosurface, stale, normal);
     surface_detail::turned_over_quads(ctx, normal, turned);
@@ -170,15 +187,18 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
     std::size_t moved = 0;
     for (const auto& cls : surface_detail::read_disjoint_classes(work, ctx.graph, ctx.guard_hexes ? &mesh : nullptr)) {
       tbb::parallel_for(std::size_t{0}, cls.size(), [&](std::size_t i) {
-        outcome[cls[i]] =
-            surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius, options.worst_levels, turned,
-                                             options.worst_target);
+        outcome[cls[i]] = settled[cls[i]] ? MoveOutcome::dropped
+                                          : surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius,
+                                                                             options.worst_levels, turned,
+                                                                             options.worst_target);
       });
-      for (Index v : cls) {
+      for (Index v : cls) settled[v] = outcome[v] != MoveOutcome::accepted;
+      for (Index v : cls) {  // after: a move unsettles its class-mates too
         if (outcome[v] != MoveOutcome::accepted) continue;
         ++moved;
         for (Index k = ctx.graph.vertex_quads.offsets[v]; k < ctx.graph.vertex_quads.offsets[v + 1]; ++k)
           for (Index x : ctx.graph.quads[ctx.graph.vertex_quads.ids[k]]) stale[x] = 1;
+        unsettle_around(v);
       }
     }
     report.worst_moves += moved;
