@@ -69,6 +69,25 @@ std::array<std::array<Vec3, 8>, kAllFrames> make_coefficients() {
 }
 const std::array<std::array<Vec3, 8>, kAllFrames> kCoef = make_coefficients();
 
+// The nonzero entries of each frame's coefficients, in corner order: an interior frame's
+// corners mostly enter only some of its columns (an edge midpoint's frame uses 10 of the 24),
+// and a zero product adds nothing to a sum that starts at +0 (which never becomes -0), so
+// interior_frame() skips them with the same bits (it was a fifth of the worst pass's
+// instructions, through the ratio terms' 27 lattice frames per hex).
+struct CoefEntry {
+  std::uint8_t k, j;
+  double c;
+};
+const std::array<std::vector<CoefEntry>, kAllFrames> kCoefEntries = [] {
+  std::array<std::vector<CoefEntry>, kAllFrames> e;
+  for (int t = 0; t < kAllFrames; ++t)
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 3; ++j)
+        if (kCoef[t][k][j] != 0)
+          e[t].push_back({static_cast<std::uint8_t>(k), static_cast<std::uint8_t>(j), kCoef[t][k][j]});
+  return e;
+}();
+
 // The scalar derivatives of one frame's energy f(F, D), F = |A|², D = det A.
 struct Scalar {
   double f = 0, fF = 0, fD = 0, fFD = 0, fDD = 0;
@@ -214,13 +233,11 @@ Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   // scaled: the arithmetic of the matrix expression `A += (P_k − P_0) c_kᵀ`, whose
   // temporaries on the stack stalled every load (most of frame()'s samples on cthead).
   double a[3][3] = {};
-  const auto& coef = kCoef[static_cast<std::size_t>(t)];
-  for (int k = 0; k < 8; ++k) {
-    const double d[3] = {p[k][0] - p[0][0], p[k][1] - p[0][1], p[k][2] - p[0][2]};
-    const Vec3& c = coef[static_cast<std::size_t>(k)];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) a[i][j] += d[i] * c[j];
-  }
+  double d[8][3];
+  for (int k = 0; k < 8; ++k)
+    for (int i = 0; i < 3; ++i) d[k][i] = p[k][i] - p[0][i];
+  for (const CoefEntry& e : kCoefEntries[static_cast<std::size_t>(t)])
+    for (int i = 0; i < 3; ++i) a[i][e.j] += d[e.k][i] * e.c;
   Mat3 A;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;

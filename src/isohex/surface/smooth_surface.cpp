@@ -155,12 +155,13 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
   std::vector<Index> work;
   // A vertex whose search found nothing finds nothing again until a vertex it reads moves:
   // raise_worst_quad() reads the quads of v and of its boundary neighbours, the turned flags
-  // of v's quads (the normals of their vertices: their quads' vertices for a box-face vertex)
-  // and with the hex guard the corners of v's hexes; all within two quad rings of v or in its
-  // hexes. So a move unsettles those of the mover, and a settled vertex is left as its search
-  // would leave it, in the same classes (the same mesh: on cthead h 2 most of the 40 passes'
-  // searches were repeats).
+  // of v's quads as the pass began (the normals of their vertices: their quads' vertices for a
+  // box-face vertex; their hexes' opposite faces) and with the hex guard the corners of v's
+  // hexes; all within two quad rings of v or in its hexes. So a move unsettles those of the
+  // mover, and a settled vertex is left as its search would leave it, in the same classes
+  // (the same mesh: on cthead h 2 over half of the last passes' searches were repeats).
   std::vector<std::uint8_t> settled(mesh.points.size(), 0);
+  std::vector<Index> movers;
   const auto unsettle_around = [&](Index w) {
     const auto& vq = ctx.graph.vertex_quads;
     for (Index k = vq.offsets[w]; k < vq.offsets[w + 1]; ++k)
@@ -199,8 +200,13 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
         for (Index k = ctx.graph.vertex_quads.offsets[v]; k < ctx.graph.vertex_quads.offsets[v + 1]; ++k)
           for (Index x : ctx.graph.quads[ctx.graph.vertex_quads.ids[k]]) stale[x] = 1;
         unsettle_around(v);
+        movers.push_back(v);
       }
     }
+    // The turned flags are the pass's own: a vertex that found nothing after a move near it
+    // in this pass reads that move in the next pass's flags.
+    for (Index v : movers) unsettle_around(v);
+    movers.clear();
     report.worst_moves += moved;
     if (moved == 0) break;
   }
