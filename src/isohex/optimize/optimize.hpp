@@ -368,7 +368,9 @@ struct WorstResult {
   std::vector<QualityBound> proven;
 };
 
-/// Raises the lowest scaled Jacobians in place; the mesh minimum never decreases.
+/// Raises the lowest scaled Jacobians in place; the mesh minimum never decreases. The single
+/// passes move vertices worst first as one sequence, the moves of vertices that share no hex
+/// in parallel: the sequence's result, bit for bit, for any thread count.
 WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const WorstOptions& options = {});
 
 /// The whole sequence `isohex smooth` and `isohex mesh` run: untangle (optional), shape, worst
