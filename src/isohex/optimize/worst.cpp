@@ -192,6 +192,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
   };
   const auto one_pass = [&](double min_now, double floor_now) {
     std::size_t moved = 0;
+    const auto is_settled = [&](Index v) { return settled[v] && settled_at[v] == floor_now; };
     const auto undo_from = [&](std::size_t first) {
       for (std::size_t k = moves.size(); k-- > first;) {
         const Index v = moves.vertex(k);
@@ -224,7 +225,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
           seen[v] = pass;
           // A settled vertex that no move before it can unsettle is no move at all.
           const int level = moves.level_of(v);
-          if (level > 0 || !(settled[v] && settled_at[v] == floor_now)) moves.add(v, level);
+          if (level > 0 || !is_settled(v)) moves.add(v, level);
         }
         ++i;
       }
@@ -236,7 +237,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
           [&](std::size_t k) {
             const Index v = moves.vertex(k);
             old[k] = mesh.points[v];
-            if (settled[v] && settled_at[v] == floor_now) return;
+            if (is_settled(v)) return;
             if (!opt::worst_move(mesh, inc, v, start, options.surface, options, min_now)) {
               outcome[k] = kFailed;
               return;

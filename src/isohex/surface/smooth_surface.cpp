@@ -157,20 +157,22 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
   // raise_worst_quad() reads the quads of v and of its boundary neighbours, the turned flags
   // of v's quads as the pass began (the normals of their vertices: their quads' vertices for a
   // box-face vertex; their hexes' opposite faces) and with the hex guard the corners of v's
-  // hexes; all within two quad rings of v or in its hexes. So a move unsettles those of the
-  // mover, and a settled vertex is left as its search would leave it, in the same classes
-  // (the same mesh: on cthead h 2 over half of the last passes' searches were repeats).
-  std::vector<std::uint8_t> settled(mesh.points.size(), 0);
-  std::vector<Index> movers;
-  const auto unsettle_around = [&](Index w) {
+  // hexes; all within two quad rings of v or in its hexes. So a vertex is searched again once
+  // such a vertex has moved in or after the pass where its search found nothing (a move
+  // earlier in that pass shows in the next pass's turned flags), and a settled vertex is left
+  // as its search would leave it, in the same classes (the same mesh: on cthead h 2 over half
+  // of the last passes' searches were repeats).
+  std::vector<int> dropped_in(mesh.points.size(), -1), touched_in(mesh.points.size(), -1);
+  const auto touch_around = [&](Index w, int pass) {
     const auto& vq = ctx.graph.vertex_quads;
     for (Index k = vq.offsets[w]; k < vq.offsets[w + 1]; ++k)
       for (Index x : ctx.graph.quads[vq.ids[k]])
         for (Index j = vq.offsets[x]; j < vq.offsets[x + 1]; ++j)
-          for (Index y : ctx.graph.quads[vq.ids[j]]) settled[y] = 0;
+          for (Index y : ctx.graph.quads[vq.ids[j]]) touched_in[y] = pass;
     for (Index k = ctx.graph.vertex_hexes.offsets[w]; k < ctx.graph.vertex_hexes.offsets[w + 1]; ++k)
-      for (Index y : mesh.hexes[ctx.graph.vertex_hexes.ids[k]]) settled[y] = 0;
+      for (Index y : mesh.hexes[ctx.graph.vertex_hexes.ids[k]]) touched_in[y] = pass;
   };
+  const auto settled = [&](Index v) { return dropped_in[v] >= 0 && touched_in[v] < dropped_in[v]; };
   for (int pass = 0; pass < options.worst_passes; ++pass) {
     surface_detail::update_normals(ctx, on_isosurface, stale, normal);
     surface_detail::turned_over_quads(ctx, normal, turned);
@@ -188,25 +190,23 @@ void worst_quad_passes(const MoveContext& ctx, const std::vector<Index>& sliding
     std::size_t moved = 0;
     for (const auto& cls : surface_detail::read_disjoint_classes(work, ctx.graph, ctx.guard_hexes ? &mesh : nullptr)) {
       tbb::parallel_for(std::size_t{0}, cls.size(), [&](std::size_t i) {
-        outcome[cls[i]] = settled[cls[i]] ? MoveOutcome::dropped
+        outcome[cls[i]] = settled(cls[i]) ? MoveOutcome::dropped
                                           : surface_detail::raise_worst_quad(ctx, cls[i], options.worst_radius,
                                                                              options.worst_levels, turned,
                                                                              options.worst_target);
       });
-      for (Index v : cls) settled[v] = outcome[v] != MoveOutcome::accepted;
-      for (Index v : cls) {  // after: a move unsettles its class-mates too
-        if (outcome[v] != MoveOutcome::accepted) continue;
+      for (Index v : cls) {
+        if (outcome[v] != MoveOutcome::accepted) {
+          if (!settled(v)) dropped_in[v] = pass;
+          continue;
+        }
+        dropped_in[v] = -1;
         ++moved;
         for (Index k = ctx.graph.vertex_quads.offsets[v]; k < ctx.graph.vertex_quads.offsets[v + 1]; ++k)
           for (Index x : ctx.graph.quads[ctx.graph.vertex_quads.ids[k]]) stale[x] = 1;
-        unsettle_around(v);
-        movers.push_back(v);
+        touch_around(v, pass);
       }
     }
-    // The turned flags are the pass's own: a vertex that found nothing after a move near it
-    // in this pass reads that move in the next pass's flags.
-    for (Index v : movers) unsettle_around(v);
-    movers.clear();
     report.worst_moves += moved;
     if (moved == 0) break;
   }
