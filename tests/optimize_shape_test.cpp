@@ -2,6 +2,7 @@
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/generate.hpp"
 #include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/frame_terms.hpp"
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
 #include "isohex/quality/hex_quality.hpp"
@@ -86,6 +87,66 @@ TEST(OptimizeShape, DerivativesMatchFiniteDifferences) {
             1e-6);
 }
 
+// vertex_energy() evaluates its frames four at a time (FrameBatch): the same bits as a loop
+// over the frames one by one in the matrix expressions of the formulas (|A|², det A, ∇F =
+// 2·il·A·c, ∇D = il·Σ c_j (a_{j+1} × a_{j+2}), the Hessian's terms), summed in frame order; for
+// the shape energy, the untangler's, and the untangler's over all 35 frames. Fails if a lane's
+// arithmetic leaves the scalar order (a sum regrouped, a factor moved).
+TEST(OptimizeShape, BatchedFramesGiveTheFrameByFrameBits) {
+  HexMesh m = jittered_box(3, 0.3, 5);
+  const Incidence inc = vertex_hexes(m);
+  const std::vector<double> il = opt::inverse_edge_lengths(m);
+  const std::vector<std::uint8_t> all(m.hexes.size(), 1);
+  opt::EnergyParams interior{true, 0.05, 0.5};
+  interior.interior = &all;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  int compared = 0;
+  for (const opt::EnergyParams& p : {opt::EnergyParams{}, opt::EnergyParams{true, 0.3, 0.5}, interior})
+    for (Index v = 0; v < m.num_vertices(); ++v) {
+      const Vec3 x = m.points[v] + Vec3(u(rng), u(rng), u(rng));
+      double e = 0;
+      Vec3 g = Vec3::Zero();
+      opt::Mat3 H = opt::Mat3::Zero();
+      for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
+        const Index h = inc.ids[i];
+        const std::array<Vec3, 8> q = opt::corners_with(m, h, v, x);
+        int k = 0;
+        while (m.hexes[h][k] != v) ++k;
+        for (int t = 0; t < p.frames_of(h); ++t) {
+          const Vec3& c = opt::frame_coefficient(t, k);
+          if (c.isZero()) continue;
+          const opt::Mat3 A = opt::frame(q, t, il[h]);
+          const double F = A.squaredNorm(), D = A.determinant();
+          if (!p.untangle && t >= opt::kCentreFrame) {  // a constraint
+            e += D > opt::kMinFeasibleDet ? 0.0 : std::numeric_limits<double>::infinity();
+            continue;
+          }
+          const opt::TermValue<double> s = p.untangle ? opt::untangle_term(F, D, p.eps, p.lambda) : opt::shape_term(F, D);
+          e += s.f;
+          const Vec3 gF = 2 * il[h] * (A * c);
+          const Vec3 gD = il[h] * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) +
+                                   c[2] * A.col(0).cross(A.col(1)));
+          g += s.fF * gF + s.fD * gD;
+          H += (s.fF * 2 * il[h] * il[h] * c.squaredNorm()) * opt::Mat3::Identity();
+          for (int b = 0; b < 3; ++b)
+            for (int a = 0; a < 3; ++a) H(a, b) += s.fFD * (gF[a] * gD[b] + gD[a] * gF[b]) + (s.fDD * gD[a]) * gD[b];
+        }
+      }
+      if (!std::isfinite(e)) continue;
+      Vec3 gb;
+      opt::Mat3 Hb;
+      const double eb = opt::vertex_energy(m, inc, il, v, x, p, &gb, &Hb);
+      EXPECT_EQ(eb, e) << v;
+      EXPECT_EQ(gb, g) << v;
+      for (int b = 0; b < 3; ++b)
+        for (int a = b; a < 3; ++a) EXPECT_EQ(Hb(a, b), H(a, b)) << v << " " << a << b;  // the eigensolver's half
+      EXPECT_EQ(Hb, Hb.transpose());
+      ++compared;
+    }
+  EXPECT_GT(compared, 150);
+}
+
 // The line search's model of a vertex's energy (model_energy()) against the energy itself
 // (vertex_energy()) at displaced places: the same to rounding for the shape energy (with its
 // barrier: +inf exactly where the hexes' frames fold), the untangler's, and the untangler's
@@ -98,7 +159,7 @@ TEST(OptimizeShape, TermModelMatchesTheEnergy) {
   const std::vector<std::uint8_t> all(m.hexes.size(), 1);
   opt::EnergyParams full{true, 0.05, 0.5};
   full.interior = full.bernstein = &all;
-  std::vector<opt::TermModel> model;
+  opt::TermModels model;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);
   const double len = 1.0 / 3;

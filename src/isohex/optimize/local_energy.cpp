@@ -1,6 +1,8 @@
 // Frames, per-frame energies with exact derivatives, per-vertex Newton moves, sweeps.
 #include "isohex/optimize/local_energy.hpp"
 
+#include "isohex/optimize/frame_terms.hpp"
+
 #include "isohex/quality/hex_quality.hpp"
 #include "isohex/quality/jacobian_bounds.hpp"
 
@@ -88,60 +90,13 @@ const std::array<std::vector<CoefEntry>, kAllFrames> kCoefEntries = [] {
   return e;
 }();
 
-// The scalar derivatives of one frame's energy f(F, D), F = |A|², D = det A.
-struct Scalar {
-  double f = 0, fF = 0, fD = 0, fFD = 0, fDD = 0;
-};
-
-// Regularised energy (ε > 0): finite for every D, so the untangler may cross inverted states.
-[[gnu::always_inline]] inline Scalar untangle_term(double F, double D, double eps, double lambda) {
-  const double s = std::sqrt(eps * eps + D * D);
-  // (D + s)/2 cancels for D << 0; the same value as ε²/(2(s − D)) there.
-  const double chi = D >= 0 ? 0.5 * (D + s) : eps * eps / (2 * (s - D));
-  const double chi1 = chi / s;                      // dχ/dD
-  const double chi2 = eps * eps / (2 * s * s * s);  // d²χ/dD²
-  const double y = inverse_cbrt(chi), y3 = y * y * y;
-  const double c23 = y * y, c53 = c23 * y3, c83 = c53 * y3;  // χ^(−2/3), χ^(−5/3), χ^(−8/3)
-  const double q = D * D + 1;
-  Scalar r;
-  r.f = F * c23 / 3 + lambda * q / chi;
-  r.fF = c23 / 3;
-  r.fFD = -(2.0 / 9.0) * c53 * chi1;
-  r.fD = F * r.fFD + lambda * (2 * D / chi - q * chi1 / (chi * chi));
-  r.fDD = F / 3 * ((10.0 / 9.0) * c83 * chi1 * chi1 - (2.0 / 3.0) * c53 * chi2) +
-          lambda * (2 / chi - 4 * D * chi1 / (chi * chi) + 2 * q * chi1 * chi1 / (chi * chi * chi) - q * chi2 / (chi * chi));
-  return r;
-}
-
-// Knupp's inverse mean ratio F / (3 D^{2/3}); a barrier: +inf unless D is safely positive.
-[[gnu::always_inline]] inline Scalar shape_term(double F, double D) {
-  Scalar r;
-  if (!(D > kMinFeasibleDet)) {
-    r.f = kInf;
-    return r;
-  }
-  const double y = inverse_cbrt(D), y3 = y * y * y;
-  const double c23 = y * y, c53 = c23 * y3, c83 = c53 * y3;  // D^(−2/3), D^(−5/3), D^(−8/3)
-  r.f = F * c23 / 3;
-  r.fF = c23 / 3;
-  r.fFD = -(2.0 / 9.0) * c53;
-  r.fD = F * r.fFD;
-  r.fDD = F * (10.0 / 27.0) * c83;
-  return r;
-}
-
-[[gnu::always_inline]] inline Scalar term(double F, double D, int t, const EnergyParams& params, double eps) {
-  if (params.untangle) return untangle_term(F, D, eps, params.lambda);
-  if (t >= kCentreFrame) {  // the centre and interior frames only constrain (validity), they are not optimised
-    Scalar r;
-    if (!(D > kMinFeasibleDet)) r.f = kInf;
-    return r;
-  }
-  return shape_term(F, D);
-}
-
-[[gnu::always_inline]] inline Scalar term(const Mat3& A, int t, const EnergyParams& params, double eps) {
-  return term(A.squaredNorm(), A.determinant(), t, params, eps);
+// One frame's energy: the untangler's, the shape term, or for the shape stage's centre and
+// interior frames a constraint (validity), not optimised.
+[[gnu::always_inline]] inline double term_value(const Mat3& A, int t, const EnergyParams& params, double eps) {
+  const double F = A.squaredNorm(), D = A.determinant();
+  if (params.untangle) return untangle_term(F, D, eps, params.lambda).f;
+  if (t >= kCentreFrame) return D > kMinFeasibleDet ? 0.0 : kInf;
+  return shape_term(F, D).f;
 }
 
 // The Bernstein coefficients of det J of the hex p (at the frames' scale inv_len³) that are
@@ -150,7 +105,7 @@ struct Scalar {
 // lemma, and the coefficients are fixed combinations of them), so its term's Hessian is
 // f''(b) ∇b ∇bᵀ. With `g`, the gradient and Hessian in corner k's place are added.
 double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, const EnergyParams& params, double eps,
-                        Vec3* g, Mat3* H, std::vector<TermModel>* model = nullptr);
+                        Vec3* g, Mat3* H, TermModels* model = nullptr);
 
 }  // namespace
 
@@ -180,7 +135,7 @@ const std::array<int, 27>& lattice_frames() {
 namespace {
 
 double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, const EnergyParams& params, double eps,
-                        Vec3* g, Mat3* H, std::vector<TermModel>* model) {
+                        Vec3* g, Mat3* H, TermModels* model) {
   const std::array<int, 27>& lattice = lattice_frames();
   std::array<double, 27> b, gx, gy, gz;  // values and gradients, transformed alike
   for (int n = 0; n < 27; ++n) {
@@ -202,11 +157,11 @@ double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, con
   double e = 0;
   for (int n = 0; n < 27; ++n) {
     if (n == 0 || n == 2 || n == 6 || n == 8 || n == 18 || n == 20 || n == 24 || n == 26) continue;  // corners
-    const Scalar s = untangle_term(0, b[n], eps, params.lambda);
+    const TermValue<double> s = untangle_term(0.0, b[n], eps, params.lambda);
     e += s.f;
     if (!g) continue;
     const Vec3 gb(gx[n], gy[n], gz[n]);
-    if (model) model->push_back({0, b[n], 0, eps, Vec3::Zero(), gb, TermModel::Kind::bernstein});
+    if (model) model->push(0, b[n], 0, eps, Vec3::Zero(), gb, false);
     *g += s.fD * gb;
     if (H) *H += s.fDD * (gb * gb.transpose());
   }
@@ -247,7 +202,7 @@ Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
 double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps, int frames) {
   if (eps < 0) eps = params.eps;
   double e = 0;
-  for (int t = 0; t < frames; ++t) e += term(frame(p, t, inv_len), t, params, eps).f;
+  for (int t = 0; t < frames; ++t) e += term_value(frame(p, t, inv_len), t, params, eps);
   return e;
 }
 
@@ -291,67 +246,37 @@ bool stays_feasible(const HexMesh& mesh, const Incidence& inc, const std::vector
 
 namespace {
 
-// How frame t's coefficient c_{t,k} is made: a unit vector e_j (corner k is the j-th neighbour
-// of corner t), (−1, −1, −1) (frame t is corner k's own) or anything else (the centre and
-// interior frames). The gradient of det A needs one cross product for e_j instead of three;
-// the arithmetic is that of the general formula with its zero terms left out, so the same
-// bits (vertex_energy() was about half of the shape stage's time).
-enum class CoefKind : std::uint8_t { zero, unit0, unit1, unit2, own, general };
-
-const std::array<std::array<CoefKind, 8>, kAllFrames> kKinds = [] {
-  std::array<std::array<CoefKind, 8>, kAllFrames> kinds;
+// |c_{t,k}|² as Eigen gives it, and whether frame t sees corner k at all (a zero coefficient:
+// its term is a constant of the vertex's place).
+const std::array<std::array<double, 8>, kAllFrames> kCoefSq = [] {
+  std::array<std::array<double, 8>, kAllFrames> sq;
   for (int t = 0; t < kAllFrames; ++t)
-    for (int k = 0; k < 8; ++k) {
-      const Vec3& c = kCoef[t][k];
-      CoefKind kind = CoefKind::general;
-      if (c.isZero()) kind = CoefKind::zero;
-      else if (c == Vec3(-1, -1, -1)) kind = CoefKind::own;
-      else
-        for (int j = 0; j < 3; ++j)
-          if (c == Vec3::Unit(j)) kind = static_cast<CoefKind>(static_cast<int>(CoefKind::unit0) + j);
-      kinds[t][k] = kind;
-    }
-  return kinds;
+    for (int k = 0; k < 8; ++k) sq[t][k] = kCoef[t][k].squaredNorm();
+  return sq;
 }();
 
-// d/dx of F = |A|² and of D = det A when A changes by il·dx cᵀ (c of kind `kind`).
-[[gnu::always_inline]] inline void frame_gradients(const Mat3& A, const Vec3& c, CoefKind kind, double il, Vec3& gF, Vec3& gD) {
-  switch (kind) {
-    case CoefKind::unit0:
-    case CoefKind::unit1:
-    case CoefKind::unit2: {
-      const int j = static_cast<int>(kind) - static_cast<int>(CoefKind::unit0);
-      gF = 2 * il * A.col(j);
-      gD = il * A.col((j + 1) % 3).cross(A.col((j + 2) % 3));
-      return;
-    }
-    case CoefKind::own:
-      gF = 2 * il * (A * c);  // Eigen's product (its own order of sums)
-      gD = il * (-A.col(1).cross(A.col(2)) - A.col(2).cross(A.col(0)) - A.col(0).cross(A.col(1)));
-      return;
-    default:
-      gF = 2 * il * (A * c);
-      gD = il * (c[0] * A.col(1).cross(A.col(2)) + c[1] * A.col(2).cross(A.col(0)) + c[2] * A.col(0).cross(A.col(1)));
-  }
-}
-
-// H += fFD (gF gDᵀ + gD gFᵀ) + fDD gD gDᵀ, entry by entry: the operations of the matrix
-// expression (whose scalar factor Eigen applies to the outer product's left vector), without
-// its temporaries.
-[[gnu::always_inline]] inline void add_hessian(const Scalar& s, const Vec3& gF, const Vec3& gD, Mat3& H) {
-  for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i) H(i, j) += s.fFD * (gF[i] * gD[j] + gD[i] * gF[j]) + (s.fDD * gD[i]) * gD[j];
-}
+// The hexes of one vertex_energy() call, in incidence order, with their frames' range in the batch.
+struct HexFrames {
+  Index h;
+  int k;
+  double il, eps;
+  std::size_t first, last;
+};
 
 }  // namespace
 
 double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
-                     const Vec3& x, const EnergyParams& params, Vec3* g, Mat3* H, std::vector<TermModel>* model) {
-  double e = 0;
+                     const Vec3& x, const EnergyParams& params, Vec3* g, Mat3* H, TermModels* model) {
   if (!g) model = nullptr;
-  if (model) model->clear();
+  if (model) model->clear(params.untangle);
   if (g) g->setZero();
   if (H) H->setZero();
+  // Per-thread buffers: a move runs to its end on its thread.
+  thread_local FrameBatch batch;
+  thread_local std::vector<HexFrames> hexes;
+  batch.clear();
+  hexes.clear();
+  bool bernstein = false;
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     if (params.skip && (*params.skip)[h]) continue;
@@ -359,64 +284,69 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     int k = 0;
     while (mesh.hexes[h][k] != v) ++k;
     p[k] = x;
-    const double il = inv_len[h];
-    const double eps = params.eps_of(h);
+    HexFrames hf{h, k, inv_len[h], params.eps_of(h), batch.size, 0};
     const int frames = params.frames_of(h);
-    // One frame's term (false: the energy is infinite). Inlined into each branch below, so that
-    // a corner frame stays in registers: merged through memory, its reload after the stores
-    // stalled (a tenth of the function's samples).
-    const auto visit = [&](const Mat3& A, int t, CoefKind kind) __attribute__((always_inline)) {
-      const double F = A.squaredNorm(), D = A.determinant();
-      const Scalar s = term(F, D, t, params, eps);
-      e += s.f;
-      if (!std::isfinite(e)) return false;
-      // The shape stage's centre and interior frames only constrain: no derivatives.
-      const bool constraint = !params.untangle && t >= kCentreFrame;
-      if (!g || (constraint && !model)) return true;
-      const Vec3& c = kCoef[t][k];
-      Vec3 gF, gD;
-      frame_gradients(A, c, kind, il, gF, gD);
-      if (model)
-        model->push_back({F, D, il * il * c.squaredNorm(), eps, gF, gD,
-                          params.untangle ? TermModel::Kind::untangle
-                                          : constraint ? TermModel::Kind::constraint : TermModel::Kind::shape});
-      if (constraint) return true;
-      *g += s.fF * gF + s.fD * gD;
-      if (H) {
-        *H += (s.fF * 2 * il * il * c.squaredNorm()) * Mat3::Identity();
-        add_hessian(s, gF, gD, *H);
-      }
-      return true;
-    };
     for (int t = 0; t < frames; ++t) {
-      const CoefKind kind = kKinds[t][k];
-      if (kind == CoefKind::zero) continue;  // frame t does not see vertex v: its term is a constant
-      // Each branch builds the matrix it visits: one matrix merged from both at a join went
-      // through memory again (the stall frame() is inline to avoid).
-      if (!(t < 8 ? visit(corner_frame(p, t, il), t, kind) : visit(frame(p, t, il), t, kind))) return kInf;
+      const Vec3& c = kCoef[t][k];
+      if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
+      const std::size_t j = batch.add();
+      if (t < 8) {  // corner_frame()'s entries, written in place
+        const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
+        for (int col = 0; col < 3; ++col)
+          for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kA + r + 3 * col) = (p[nb[col]][r] - p[t][r]) * hf.il;
+      } else {
+        const Mat3 A = frame(p, t, hf.il);
+        for (int e = 0; e < 9; ++e) batch.at(j, FrameBatch::kA + e) = A.data()[e];
+      }
+      for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kC + r) = c[r];
+      batch.at(j, FrameBatch::kIl) = hf.il, batch.at(j, FrameBatch::kSq) = kCoefSq[t][k], batch.at(j, FrameBatch::kEps) = hf.eps;
+      batch.at(j, FrameBatch::kConstraint) = !params.untangle && t >= kCentreFrame;
     }
-    if (params.bernstein_of(h)) {
-      e += bernstein_energy(p, k, il, params, eps, g, H, model);
+    hf.last = batch.size;
+    hexes.push_back(hf);
+    bernstein = bernstein || params.bernstein_of(h);
+  }
+  batch.compute(params.untangle, params.lambda);
+  // The sums in frame order, hex by hex (a hex's Bernstein terms after its frames): those of
+  // one frame at a time, bit for bit. H: its lower triangle (all the eigensolver reads), then
+  // mirrored.
+  double e = 0;
+  for (const HexFrames& hf : hexes) {
+    for (std::size_t j = hf.first; j < hf.last; ++j) {
+      // The shape stage's centre and interior frames only constrain: no derivatives.
+      const bool constraint = batch.at(j, FrameBatch::kConstraint) != 0;
+      const double D = batch.at(j, FrameBatch::kD);
+      e += constraint ? (D > kMinFeasibleDet ? 0.0 : kInf) : batch.at(j, FrameBatch::kValue);
+      if (!std::isfinite(e)) return kInf;
+      if (!g) continue;
+      if (model && bernstein)  // terms to interleave: copied one by one
+        model->push(batch.at(j, FrameBatch::kF), D, batch.at(j, FrameBatch::kCc), hf.eps,
+                    Vec3(batch.at(j, FrameBatch::kGF), batch.at(j, FrameBatch::kGF + 1), batch.at(j, FrameBatch::kGF + 2)),
+                    Vec3(batch.at(j, FrameBatch::kGD), batch.at(j, FrameBatch::kGD + 1), batch.at(j, FrameBatch::kGD + 2)),
+                    constraint);
+      if (constraint) continue;
+      for (int i = 0; i < 3; ++i) (*g)[i] += batch.at(j, FrameBatch::kGrad + i);
+      if (!H) continue;
+      const double id = batch.at(j, FrameBatch::kIdentity);
+      int n = FrameBatch::kHessian;
+      for (int c = 0; c < 3; ++c) {
+        (*H)(c, c) += id;
+        for (int r = c; r < 3; ++r) (*H)(r, c) += batch.at(j, n++);
+      }
+    }
+    if (params.bernstein_of(hf.h)) {
+      std::array<Vec3, 8> p = mesh.corners(hf.h);
+      p[hf.k] = x;
+      e += bernstein_energy(p, hf.k, hf.il, params, hf.eps, g, H, model);
       if (!std::isfinite(e)) return kInf;
     }
   }
-  return e;
-}
-
-double model_energy(const std::vector<TermModel>& model, const Vec3& d, double lambda) {
-  const double dd = d.squaredNorm();
-  double e = 0;
-  for (const TermModel& m : model) {
-    const double D = m.D0 + m.gD.dot(d);
-    switch (m.kind) {
-      case TermModel::Kind::shape: e += shape_term(m.F0 + m.gF.dot(d) + m.cc * dd, D).f; break;
-      case TermModel::Kind::constraint:
-        if (!(D > kMinFeasibleDet)) return kInf;
-        break;
-      case TermModel::Kind::untangle: e += untangle_term(m.F0 + m.gF.dot(d) + m.cc * dd, D, m.eps, lambda).f; break;
-      case TermModel::Kind::bernstein: e += untangle_term(0, D, m.eps, lambda).f; break;
-    }
-    if (!std::isfinite(e)) return kInf;
+  if (H)
+    for (int c = 0; c < 3; ++c)
+      for (int r = c + 1; r < 3; ++r) (*H)(c, r) = (*H)(r, c);
+  if (model) {
+    if (!bernstein) std::swap(model->terms, batch);  // the frames are the terms, in order
+    model->seal();
   }
   return e;
 }
@@ -426,7 +356,7 @@ Move newton_move(const HexMesh& mesh, const Incidence& inc, const std::vector<do
   Move m{mesh.points[v], 0, false, 0};
   Vec3 g;
   Mat3 H;
-  thread_local std::vector<TermModel> model;  // the trials' energy (a buffer per thread, as below)
+  thread_local TermModels model;  // the trials' energy (a buffer per thread, as below)
   const double e0 = vertex_energy(mesh, inc, inv_len, v, m.x, params, &g, &H, &model);
   if (!std::isfinite(e0) || inc.count(v) == 0) return m;
   const double len = vertex_length(inc, inv_len, v);

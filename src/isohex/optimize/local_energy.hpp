@@ -180,20 +180,76 @@ inline double hex_rank(const CertifiedQuality& c) {
 /// of 0.1 is poor, kPoorJacobianRatio; the bound is at most the ratio).
 inline constexpr double kShapeRatioFloor = 0.1;
 
-/// One term of a vertex's energy as a function of the vertex's displacement d from where it
-/// was recorded: the frame changes by the rank-one il·d·cᵀ, so its F = |A|² is F0 + gF·d +
+/// Frames (or a vertex's energy terms) stored four to a block, field by field, for vector
+/// arithmetic over four at a time (frame_batch.cpp; the lanes do a frame-by-frame loop's
+/// operations in its order, so the same bits).
+struct FrameBatch {
+  enum Field : int {
+    kA = 0,           ///< in: the frame A, column-major: A(r, c) at kA + r + 3c
+    kC = 9,           ///< in: the vertex's coefficient c in it (3)
+    kIl = 12,         ///< in: 1/L of its hex
+    kSq = 13,         ///< in: |c|² (as Eigen's squaredNorm() gives it)
+    kEps = 14,        ///< in: the untangler's ε of its hex
+    kConstraint = 15, ///< in: 1 for the shape stage's centre and interior frames (validity only)
+    kF = 16,          ///< out: F = |A|²
+    kD = 17,          ///< out: D = det A
+    kValue = 18,      ///< out: the term's energy (the shape term's for a constraint too)
+    kGrad = 19,       ///< out: its gradient in the vertex's place (3)
+    kIdentity = 22,   ///< out: its Hessian's multiple of the identity, fF·2·il²·|c|²
+    kHessian = 25,    ///< out: the rest of its Hessian, lower triangle (0,0) (1,0) (2,0) (1,1) (2,1) (2,2)
+    kGF = 31,         ///< out: ∇F (3)
+    kGD = 34,         ///< out: ∇D (3)
+    kCc = 37,         ///< out: il²·|c|², F's curvature along a step
+    kFields = 38
+  };
+  static constexpr std::size_t kBlock = 4 * kFields;
+
+  std::vector<double> data;
+  std::size_t size = 0;
+
+  void clear() { size = 0; }
+  double& at(std::size_t i, int field) { return data[(i / 4) * kBlock + static_cast<std::size_t>(field) * 4 + i % 4]; }
+  double at(std::size_t i, int field) const {
+    return data[(i / 4) * kBlock + static_cast<std::size_t>(field) * 4 + i % 4];
+  }
+  /// A new slot at the end (its fields unset).
+  std::size_t add() {
+    if (size % 4 == 0 && data.size() < (size / 4 + 1) * kBlock) data.resize((size / 4 + 1) * kBlock);
+    return size++;
+  }
+  /// Evaluates every frame's outputs from its inputs: the untangler's term (its ε, volume weight
+  /// `lambda`) or the shape term.
+  void compute(bool untangle, double lambda);
+};
+
+/// The terms of a vertex's energy as functions of the vertex's displacement d from where they
+/// were recorded: a frame changes by the rank-one il·d·cᵀ, so its F = |A|² is F0 + gF·d +
 /// cc·|d|² and its D = det A is D0 + gD·d, exactly (a Bernstein coefficient is affine alike).
 /// A line search's trial then costs a few products per term instead of rebuilding the frames
 /// from the corners (the untangler's searches on cthead took 2.1 trials a move, some 15).
-struct TermModel {
-  enum class Kind : std::uint8_t { shape, constraint, untangle, bernstein };
-  double F0 = 0, D0 = 0, cc = 0, eps = 0;
-  Vec3 gF = Vec3::Zero(), gD = Vec3::Zero();
-  Kind kind = Kind::shape;
+/// Each term is a FrameBatch slot (its kF, kD, kCc, kEps, kGF, kGD and kConstraint fields):
+/// vertex_energy() hands its batch over whole where no Bernstein term comes between its frames.
+struct TermModels {
+  /// The untangler's terms (a Bernstein coefficient's is one with F0, gF and cc zero) or the
+  /// shape stage's (inverse mean ratio, or a constraint: D > kMinFeasibleDet, no energy).
+  bool untangle = false;
+  FrameBatch terms;
+
+  std::size_t size() const { return terms.size; }
+  bool empty() const { return terms.size == 0; }
+  void clear(bool untangle_terms) { terms.clear(), untangle = untangle_terms; }
+  void push(double F0, double D0, double cc, double eps, const Vec3& gF, const Vec3& gD, bool constraint) {
+    const std::size_t i = terms.add();
+    terms.at(i, FrameBatch::kF) = F0, terms.at(i, FrameBatch::kD) = D0, terms.at(i, FrameBatch::kCc) = cc;
+    terms.at(i, FrameBatch::kEps) = eps, terms.at(i, FrameBatch::kConstraint) = constraint ? 1.0 : 0.0;
+    for (int j = 0; j < 3; ++j) terms.at(i, FrameBatch::kGF + j) = gF[j], terms.at(i, FrameBatch::kGD + j) = gD[j];
+  }
+  /// Makes the last block's unused lanes a unit frame's (model_energy() evaluates whole blocks).
+  void seal();
 };
 /// The energy of the recorded terms at displacement d: what vertex_energy() gives at x + d up
-/// to rounding (+inf where a barrier term's D is at most kMinFeasibleDet).
-double model_energy(const std::vector<TermModel>& model, const Vec3& d, double lambda);
+/// to rounding (+inf where a barrier term's D is at most kMinFeasibleDet), summed in term order.
+double model_energy(const TermModels& model, const Vec3& d, double lambda);
 
 /// The energy of the hexes around vertex v with v placed at x; with g and H, also its gradient
 /// and Hessian with respect to x (the Hessian of the regularised energy may be indefinite).
@@ -201,7 +257,7 @@ double model_energy(const std::vector<TermModel>& model, const Vec3& d, double l
 /// recorded as a function of v's displacement from x, for model_energy().
 double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                      const Vec3& x, const EnergyParams& params, Vec3* g = nullptr, Mat3* H = nullptr,
-                     std::vector<TermModel>* model = nullptr);
+                     TermModels* model = nullptr);
 
 /// One Newton step of vertex v with a backtracking (Armijo) line search; returns the new
 /// position (the old one if no step lowered the energy) and the scaled gradient norm |g|·L.

@@ -1,0 +1,156 @@
+// The frames around a vertex and the terms of a line search's model, four at a time.
+#include "isohex/internal/multiversion.hpp"
+#include "isohex/optimize/local_energy.hpp"
+#include "isohex/optimize/frame_terms.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+namespace isohex::opt {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+[[gnu::always_inline]] inline d4 load(const double* p) {
+  d4 x;
+  std::memcpy(&x, p, sizeof x);
+  return x;
+}
+[[gnu::always_inline]] inline void store(double* p, d4 x) { std::memcpy(p, &x, sizeof x); }
+
+// One block of four frames. Each expression is the one the scalar code evaluated (Eigen's
+// orders for a 3×3 matrix's squaredNorm(), determinant(), A·c and cross products; the
+// gradient of a corner's own frame or of a unit coefficient is this general form with its
+// factors 1, 0 and −1, exactly), so a lane's bits are those of the scalar evaluation.
+template <bool kUntangle>
+[[gnu::always_inline]] inline void frame_block(double* b, double lambda) {
+  using F_ = FrameBatch;
+  const auto in = [&](int field) { return load(b + field * 4); };
+  const auto out = [&](int field, d4 x) { store(b + field * 4, x); };
+  const d4 a0 = in(F_::kA), a1 = in(F_::kA + 1), a2 = in(F_::kA + 2), a3 = in(F_::kA + 3), a4 = in(F_::kA + 4),
+           a5 = in(F_::kA + 5), a6 = in(F_::kA + 6), a7 = in(F_::kA + 7), a8 = in(F_::kA + 8);
+  const d4 c0 = in(F_::kC), c1 = in(F_::kC + 1), c2 = in(F_::kC + 2);
+  const d4 il = in(F_::kIl), sq = in(F_::kSq);
+  const d4 F = (((a0 * a0 + a2 * a2) + (a4 * a4 + a6 * a6)) + ((a1 * a1 + a3 * a3) + (a5 * a5 + a7 * a7))) + a8 * a8;
+  const d4 D = (a0 * (a4 * a8 - a7 * a5) - a3 * (a1 * a8 - a7 * a2)) + a6 * (a1 * a5 - a4 * a2);
+  // ∇F = 2·il·A·c (Eigen's scaled product: the factor on A's entries, rows 0 and 1 summed left
+  // to right, row 2 its last two first)
+  const d4 il2 = 2.0 * il;
+  const d4 gF0 = ((il2 * a0) * c0 + (il2 * a3) * c1) + (il2 * a6) * c2;
+  const d4 gF1 = ((il2 * a1) * c0 + (il2 * a4) * c1) + (il2 * a7) * c2;
+  const d4 gF2 = (il2 * a2) * c0 + ((il2 * a5) * c1 + (il2 * a8) * c2);
+  // ∇D = il·(c0·(a1 × a2) + c1·(a2 × a0) + c2·(a0 × a1)), a_j the columns
+  const d4 x0 = a4 * a8 - a5 * a7, x1 = a5 * a6 - a3 * a8, x2 = a3 * a7 - a4 * a6;
+  const d4 y0 = a7 * a2 - a8 * a1, y1 = a8 * a0 - a6 * a2, y2 = a6 * a1 - a7 * a0;
+  const d4 z0 = a1 * a5 - a2 * a4, z1 = a2 * a3 - a0 * a5, z2 = a0 * a4 - a1 * a3;
+  const d4 gD0 = il * ((c0 * x0 + c1 * y0) + c2 * z0);
+  const d4 gD1 = il * ((c0 * x1 + c1 * y1) + c2 * z1);
+  const d4 gD2 = il * ((c0 * x2 + c1 * y2) + c2 * z2);
+  TermValue<d4> s;
+  if constexpr (kUntangle) s = untangle_term(F, D, in(F_::kEps), lambda);
+  else s = shape_term(F, D);
+  out(F_::kF, F), out(F_::kD, D), out(F_::kValue, s.f);
+  out(F_::kGrad, s.fF * gF0 + s.fD * gD0);
+  out(F_::kGrad + 1, s.fF * gF1 + s.fD * gD1);
+  out(F_::kGrad + 2, s.fF * gF2 + s.fD * gD2);
+  out(F_::kIdentity, s.fF * 2.0 * il * il * sq);
+  const d4 gF[3] = {gF0, gF1, gF2}, gD[3] = {gD0, gD1, gD2};
+  int e = F_::kHessian;
+  for (int j = 0; j < 3; ++j)
+    for (int i = j; i < 3; ++i) out(e++, s.fFD * (gF[i] * gD[j] + gD[i] * gF[j]) + (s.fDD * gD[i]) * gD[j]);
+  out(F_::kGF, gF0), out(F_::kGF + 1, gF1), out(F_::kGF + 2, gF2);
+  out(F_::kGD, gD0), out(F_::kGD + 1, gD1), out(F_::kGD + 2, gD2);
+  out(F_::kCc, il * il * sq);
+}
+
+[[gnu::always_inline]] inline void frames_body(double* data, std::size_t blocks, bool untangle, double lambda) {
+  for (std::size_t k = 0; k < blocks; ++k) {
+    if (untangle) frame_block<true>(data + k * FrameBatch::kBlock, lambda);
+    else frame_block<false>(data + k * FrameBatch::kBlock, lambda);
+  }
+}
+
+// The energy of four recorded terms at displacement d (dd = |d|²).
+template <bool kUntangle>
+[[gnu::always_inline]] inline d4 model_block(const double* b, const Vec3& d, double dd, double lambda) {
+  using M = FrameBatch;
+  const auto in = [&](int field) { return load(b + field * 4); };
+  const d4 D = in(M::kD) + ((in(M::kGD) * d[0] + in(M::kGD + 1) * d[1]) + in(M::kGD + 2) * d[2]);
+  const d4 F = (in(M::kF) + ((in(M::kGF) * d[0] + in(M::kGF + 1) * d[1]) + in(M::kGF + 2) * d[2])) + in(M::kCc) * dd;
+  if constexpr (kUntangle) {
+    return untangle_term(F, D, in(M::kEps), lambda).f;
+  } else {
+    const d4 constraint = D > kMinFeasibleDet ? splat<d4>(0.0) : splat<d4>(kInf);
+    return in(M::kConstraint) != 0.0 ? constraint : shape_term(F, D).f;
+  }
+}
+
+[[gnu::always_inline]] inline void model_body(const double* data, std::size_t blocks, bool untangle, const Vec3& d, double lambda, double* f) {
+  const double dd = d.squaredNorm();
+  for (std::size_t k = 0; k < blocks; ++k) {
+    const double* b = data + k * FrameBatch::kBlock;
+    store(f + 4 * k, untangle ? model_block<true>(b, d, dd, lambda) : model_block<false>(b, d, dd, lambda));
+  }
+}
+
+#if ISOHEX_HAVE_FMV
+// AVX2 where the CPU has it (no FMA: the same bits as the baseline's SSE2 pairs).
+[[gnu::target("default")]] void frames_kernel(double* data, std::size_t blocks, bool untangle, double lambda) {
+  frames_body(data, blocks, untangle, lambda);
+}
+[[gnu::target("avx2")]] void frames_kernel(double* data, std::size_t blocks, bool untangle, double lambda) {
+  frames_body(data, blocks, untangle, lambda);
+}
+[[gnu::target("default")]] void model_kernel(const double* data, std::size_t blocks, bool untangle, const Vec3& d,
+                                             double lambda, double* f) {
+  model_body(data, blocks, untangle, d, lambda, f);
+}
+[[gnu::target("avx2")]] void model_kernel(const double* data, std::size_t blocks, bool untangle, const Vec3& d,
+                                          double lambda, double* f) {
+  model_body(data, blocks, untangle, d, lambda, f);
+}
+#else
+void frames_kernel(double* data, std::size_t blocks, bool untangle, double lambda) {
+  frames_body(data, blocks, untangle, lambda);
+}
+void model_kernel(const double* data, std::size_t blocks, bool untangle, const Vec3& d, double lambda, double* f) {
+  model_body(data, blocks, untangle, d, lambda, f);
+}
+#endif
+
+// The unused lanes of the last block: a unit frame with no coefficient (finite terms, no NaN).
+void pad(FrameBatch& b) {
+  for (std::size_t i = b.size; i % 4 != 0; ++i) {
+    for (int f = 0; f < FrameBatch::kFields; ++f) b.at(i, f) = 0.0;
+    for (int f : {0, 4, 8, int{FrameBatch::kIl}, int{FrameBatch::kEps}, int{FrameBatch::kD}}) b.at(i, f) = 1.0;
+    b.at(i, FrameBatch::kF) = 3.0;
+  }
+}
+
+}  // namespace
+
+void FrameBatch::compute(bool untangle, double lambda) {
+  pad(*this);
+  frames_kernel(data.data(), (size + 3) / 4, untangle, lambda);
+}
+
+void TermModels::seal() { pad(terms); }
+
+double model_energy(const TermModels& model, const Vec3& d, double lambda) {
+  const std::size_t n = model.size();
+  if (n == 0) return 0;
+  thread_local std::vector<double> f;
+  const std::size_t blocks = (n + 3) / 4;
+  if (f.size() < 4 * blocks) f.resize(4 * blocks);
+  model_kernel(model.terms.data.data(), blocks, model.untangle, d, lambda, f.data());
+  double e = 0;
+  for (std::size_t i = 0; i < n; ++i) {  // in term order: the sum of a term-by-term loop
+    e += f[i];
+    if (!std::isfinite(e)) return kInf;
+  }
+  return e;
+}
+
+}  // namespace isohex::opt
