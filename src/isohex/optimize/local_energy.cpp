@@ -138,9 +138,10 @@ double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, con
                         Vec3* g, Mat3* H, TermModels* model) {
   const std::array<int, 27>& lattice = lattice_frames();
   std::array<double, 27> b, gx, gy, gz;  // values and gradients, transformed alike
+  const RelativeCorners rel = relative_corners(p);
   for (int n = 0; n < 27; ++n) {
     const int t = lattice[static_cast<std::size_t>(n)];
-    const Mat3 A = frame(p, t, inv_len);
+    const Mat3 A = t > kCentreFrame ? interior_frame(rel, t, inv_len) : frame(p, t, inv_len);
     b[n] = A.determinant();
     if (!g) continue;
     const Vec3& c = kCoef[t][k];
@@ -183,20 +184,28 @@ std::vector<double> inverse_edge_lengths(const HexMesh& mesh) {
   return inv;
 }
 
-Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+RelativeCorners relative_corners(const std::array<Vec3, 8>& p) {
+  RelativeCorners d;
+  for (int k = 0; k < 8; ++k)
+    for (int i = 0; i < 3; ++i) d[k][i] = p[k][i] - p[0][i];
+  return d;
+}
+
+Mat3 interior_frame(const RelativeCorners& d, int t, double inv_len) {
   // Σ_k (P_k − P_0) c_{t,k}ᵀ (Σ c_k = 0: relative to P0), entry by entry in k order, then
   // scaled: the arithmetic of the matrix expression `A += (P_k − P_0) c_kᵀ`, whose
   // temporaries on the stack stalled every load (most of frame()'s samples on cthead).
   double a[3][3] = {};
-  double d[8][3];
-  for (int k = 0; k < 8; ++k)
-    for (int i = 0; i < 3; ++i) d[k][i] = p[k][i] - p[0][i];
   for (const CoefEntry& e : kCoefEntries[static_cast<std::size_t>(t)])
     for (int i = 0; i < 3; ++i) a[i][e.j] += d[e.k][i] * e.c;
   Mat3 A;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;
   return A;
+}
+
+Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
+  return interior_frame(relative_corners(p), t, inv_len);
 }
 
 double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps, int frames) {
@@ -286,6 +295,8 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     p[k] = x;
     HexFrames hf{h, k, inv_len[h], params.eps_of(h), batch.size, 0};
     const int frames = params.frames_of(h);
+    RelativeCorners d;  // the interior frames' (computed once for the hex's 26)
+    if (frames > kFrames) d = relative_corners(p);
     for (int t = 0; t < frames; ++t) {
       const Vec3& c = kCoef[t][k];
       if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
@@ -295,7 +306,7 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
         for (int col = 0; col < 3; ++col)
           for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kA + r + 3 * col) = (p[nb[col]][r] - p[t][r]) * hf.il;
       } else {
-        const Mat3 A = frame(p, t, hf.il);
+        const Mat3 A = t == kCentreFrame ? frame(p, t, hf.il) : interior_frame(d, t, hf.il);
         for (int e = 0; e < 9; ++e) batch.at(j, FrameBatch::kA + e) = A.data()[e];
       }
       for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kC + r) = c[r];

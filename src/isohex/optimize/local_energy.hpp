@@ -112,6 +112,12 @@ std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
 
 /// Frame t >= kFrames (an interior one) of corners p, scaled by inv_len (frame()).
 Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
+/// Corners p relative to p[0], entry by entry: what the interior frames are made of.
+using RelativeCorners = std::array<std::array<double, 3>, 8>;
+RelativeCorners relative_corners(const std::array<Vec3, 8>& p);
+/// interior_frame() from relative_corners(p), the same bits: one subtraction of the corners
+/// for all of a hex's interior frames.
+Mat3 interior_frame(const RelativeCorners& d, int t, double inv_len);
 
 /// Corner frame t < 8 of corners p, scaled by inv_len (frame()).
 [[gnu::always_inline]] inline Mat3 corner_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
