@@ -89,16 +89,20 @@ std::size_t lp_rescue(HexMesh& mesh, const VertexColoring& coloring, const Incid
 std::vector<std::uint8_t> frozen_outside(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& sj,
                                          double margin, int rings, const std::vector<std::uint8_t>* skip) {
   std::vector<std::uint8_t> active(mesh.points.size(), 0);
+  // Grown ring by ring from the vertices the last ring added (those of earlier rings have
+  // their neighbours in already): the set of whole-mesh passes per ring, at the cost of the rings.
+  std::vector<Index> ring, next;
   for (Index h = 0; h < mesh.num_hexes(); ++h)
     if ((!skip || !(*skip)[h]) && (sj[h] < margin || is_degenerate(sj[h])))
-      for (Index v : mesh.hexes[h]) active[v] = 1;
-  for (int r = 0; r < rings; ++r) {
-    std::vector<std::uint8_t> grown = active;
-    for (Index v = 0; v < mesh.num_vertices(); ++v)
-      if (active[v])
-        for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
-          for (Index w : mesh.hexes[inc.ids[i]]) grown[w] = 1;
-    active.swap(grown);
+      for (Index v : mesh.hexes[h])
+        if (!active[v]) active[v] = 1, ring.push_back(v);
+  for (int r = 0; r < rings && !ring.empty(); ++r) {
+    next.clear();
+    for (Index v : ring)
+      for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i)
+        for (Index w : mesh.hexes[inc.ids[i]])
+          if (!active[w]) active[w] = 1, next.push_back(w);
+    ring.swap(next);
   }
   for (std::uint8_t& a : active) a = !a;
   return active;
