@@ -147,6 +147,25 @@ TEST(OptimizeShape, BatchedFramesGiveTheFrameByFrameBits) {
   EXPECT_GT(compared, 150);
 }
 
+// interior_frames() (four frames at a time, dense coefficients) against interior_frame() one
+// frame at a time (sparse): the same bits, with and without the Gauss points.
+TEST(OptimizeShape, InteriorFramesAtOnceGiveEachFramesBits) {
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-0.4, 0.4);
+  const HexMesh cube = box_mesh(1, 1, 1);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::array<Vec3, 8> p = cube.corners(0);
+    for (Vec3& x : p) x += Vec3(u(rng), u(rng), u(rng));
+    const double il = 0.5 + u(rng);
+    for (const bool gauss : {true, false}) {
+      opt::InteriorFrames A;
+      opt::interior_frames(opt::relative_corners(p), il, A, gauss);
+      for (int t = gauss ? opt::kFrames : opt::kFrames + 8; t < opt::kAllFrames; ++t)
+        EXPECT_EQ(A[static_cast<std::size_t>(t - opt::kFrames)], opt::interior_frame(p, t, il)) << trial << " " << t;
+    }
+  }
+}
+
 // The line search's model of a vertex's energy (model_energy()) against the energy itself
 // (vertex_energy()) at displaced places: the same to rounding for the shape energy (with its
 // barrier: +inf exactly where the hexes' frames fold), the untangler's, and the untangler's

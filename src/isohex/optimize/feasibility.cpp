@@ -198,10 +198,11 @@ void ratio_coefficients(const std::array<Vec3, 8>& p, double weight, double norm
                         std::array<double, 27>& b, std::array<std::array<Vec3, 27>, 8>* g) {
   const std::array<int, 27>& lattice = lattice_frames();
   std::array<std::array<std::array<double, 27>, 3>, 8> gk;  // per corner and component: transformed alike
-  const RelativeCorners rel = relative_corners(p);
+  InteriorFrames interior;
+  interior_frames(relative_corners(p), 1.0, interior, false);
   for (int n = 0; n < 27; ++n) {
     const int t = lattice[static_cast<std::size_t>(n)];
-    const Mat3 A = t > kCentreFrame ? interior_frame(rel, t, 1.0) : frame(p, t, 1.0);
+    const Mat3 A = t > kCentreFrame ? interior[static_cast<std::size_t>(t - kFrames)] : frame(p, t, 1.0);
     b[n] = weight * A.determinant() / norm;
     for (int k = 0; g && k < 8; ++k) {
       if (!corners[k]) continue;

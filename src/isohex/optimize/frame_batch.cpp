@@ -95,6 +95,46 @@ template <bool kUntangle>
   }
 }
 
+// The interior frames' coefficients, four frames to a block: [block][corner k][column j][lane],
+// zero in a frame's place for a corner it does not use and in the last block's two spare lanes.
+constexpr int kInteriorBlocks = (kAllFrames - kFrames + 3) / 4;
+// (Built on first use: frame_coefficient()'s table is another file's static.)
+const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
+  static const std::array<double, kInteriorBlocks * 8 * 3 * 4> table = [] {
+  std::array<double, kInteriorBlocks * 8 * 3 * 4> c{};
+  for (int t = kFrames; t < kAllFrames; ++t) {
+    const int b = (t - kFrames) / 4, lane = (t - kFrames) % 4;
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 3; ++j) c[static_cast<std::size_t>(((b * 8 + k) * 3 + j) * 4 + lane)] = frame_coefficient(t, k)[j];
+  }
+  return c;
+  }();
+  return table;
+}
+
+// interior_frame() for four frames at once: Σ_k d_k c_{t,k}ᵀ entry by entry in k order, then
+// scaled. A coefficient that interior_frame() skips (zero) adds ±0 here, which leaves a sum
+// that started at +0 as it is, so the same bits.
+[[gnu::always_inline]] inline void interior_body(const RelativeCorners& d, double inv_len, Mat3* out, int first) {
+  const auto& coef = dense_coef();
+  for (int b = first; b < kInteriorBlocks; ++b) {
+    d4 a[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) a[i][j] = splat<d4>(0.0);
+    for (int k = 0; k < 8; ++k)
+      for (int j = 0; j < 3; ++j) {
+        const d4 c = load(&coef[static_cast<std::size_t>(((b * 8 + k) * 3 + j) * 4)]);
+        for (int i = 0; i < 3; ++i) a[i][j] += d[k][i] * c;
+      }
+    for (int lane = 0; lane < 4; ++lane) {
+      const int f = 4 * b + lane;
+      if (f >= kAllFrames - kFrames) break;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) out[f](i, j) = a[i][j][lane] * inv_len;
+    }
+  }
+}
+
 #if ISOHEX_HAVE_FMV
 // AVX2 where the CPU has it (no FMA: the same bits as the baseline's SSE2 pairs).
 [[gnu::target("default")]] void frames_kernel(double* data, std::size_t blocks, bool untangle, double lambda) {
@@ -111,7 +151,16 @@ template <bool kUntangle>
                                           double lambda, double* f) {
   model_body(data, blocks, untangle, d, lambda, f);
 }
+[[gnu::target("default")]] void interior_kernel(const RelativeCorners& d, double inv_len, Mat3* out, int first) {
+  interior_body(d, inv_len, out, first);
+}
+[[gnu::target("avx2")]] void interior_kernel(const RelativeCorners& d, double inv_len, Mat3* out, int first) {
+  interior_body(d, inv_len, out, first);
+}
 #else
+void interior_kernel(const RelativeCorners& d, double inv_len, Mat3* out, int first) {
+  interior_body(d, inv_len, out, first);
+}
 void frames_kernel(double* data, std::size_t blocks, bool untangle, double lambda) {
   frames_body(data, blocks, untangle, lambda);
 }
@@ -137,6 +186,11 @@ void FrameBatch::compute(bool untangle, double lambda) {
 }
 
 void TermModels::seal() { pad(terms); }
+
+void interior_frames(const RelativeCorners& d, double inv_len, InteriorFrames& out, bool gauss) {
+  // Frames 9..16 are the Gauss points (local_energy.hpp): the first two blocks.
+  interior_kernel(d, inv_len, out.data(), gauss ? 0 : 2);
+}
 
 double model_energy(const TermModels& model, const Vec3& d, double lambda) {
   const std::size_t n = model.size();

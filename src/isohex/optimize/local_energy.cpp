@@ -138,10 +138,11 @@ double bernstein_energy(const std::array<Vec3, 8>& p, int k, double inv_len, con
                         Vec3* g, Mat3* H, TermModels* model) {
   const std::array<int, 27>& lattice = lattice_frames();
   std::array<double, 27> b, gx, gy, gz;  // values and gradients, transformed alike
-  const RelativeCorners rel = relative_corners(p);
+  InteriorFrames interior;
+  interior_frames(relative_corners(p), inv_len, interior, false);
   for (int n = 0; n < 27; ++n) {
     const int t = lattice[static_cast<std::size_t>(n)];
-    const Mat3 A = t > kCentreFrame ? interior_frame(rel, t, inv_len) : frame(p, t, inv_len);
+    const Mat3 A = t > kCentreFrame ? interior[static_cast<std::size_t>(t - kFrames)] : frame(p, t, inv_len);
     b[n] = A.determinant();
     if (!g) continue;
     const Vec3& c = kCoef[t][k];
@@ -295,8 +296,8 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     p[k] = x;
     HexFrames hf{h, k, inv_len[h], params.eps_of(h), batch.size, 0};
     const int frames = params.frames_of(h);
-    RelativeCorners d;  // the interior frames' (computed once for the hex's 26)
-    if (frames > kFrames) d = relative_corners(p);
+    InteriorFrames interior;  // the hex's 26 interior frames, at once
+    if (frames > kFrames) interior_frames(relative_corners(p), hf.il, interior);
     for (int t = 0; t < frames; ++t) {
       const Vec3& c = kCoef[t][k];
       if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
@@ -306,7 +307,7 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
         for (int col = 0; col < 3; ++col)
           for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kA + r + 3 * col) = (p[nb[col]][r] - p[t][r]) * hf.il;
       } else {
-        const Mat3 A = t == kCentreFrame ? frame(p, t, hf.il) : interior_frame(d, t, hf.il);
+        const Mat3 A = t == kCentreFrame ? frame(p, t, hf.il) : interior[static_cast<std::size_t>(t - kFrames)];
         for (int e = 0; e < 9; ++e) batch.at(j, FrameBatch::kA + e) = A.data()[e];
       }
       for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kC + r) = c[r];

@@ -118,6 +118,11 @@ RelativeCorners relative_corners(const std::array<Vec3, 8>& p);
 /// interior_frame() from relative_corners(p), the same bits: one subtraction of the corners
 /// for all of a hex's interior frames.
 Mat3 interior_frame(const RelativeCorners& d, int t, double inv_len);
+/// All interior frames of a hex at once, A[t − kFrames] = interior_frame(d, t, inv_len) bit for
+/// bit (four frames at a time); without `gauss`, those of the 3×3×3 lattice only (the 8 Gauss
+/// points' A[0..7] left unset).
+using InteriorFrames = std::array<Mat3, kAllFrames - kFrames>;
+void interior_frames(const RelativeCorners& d, double inv_len, InteriorFrames& A, bool gauss = true);
 
 /// Corner frame t < 8 of corners p, scaled by inv_len (frame()).
 [[gnu::always_inline]] inline Mat3 corner_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
