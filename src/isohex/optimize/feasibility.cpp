@@ -66,10 +66,16 @@ MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<do
   // Unknowns y = (u, σ) >= 0 with d_j = box_j (u_j − 1), u_j <= 2 (the box), and s = σ − S, S
   // chosen so that y = 0 is feasible: f_i(d) >= s·w_i  ⇔  −Σ box_j a_ij u_j + w_i σ <= b_i − Σ box_j a_ij + S w_i.
   // reach[i]: how far f_i can move over the box; U: an upper bound of s (see below).
-  std::vector<double> shift(m, 0.0), reach(m, 0.0);
+  // Per-thread buffers, none zeroed that is written whole (the worst pass solves one LP per
+  // trial box: their allocations and zeroing were a tenth of its instructions).
+  thread_local std::vector<double> shift, reach, M, q, c;
+  thread_local std::vector<int> kept, B, N;
+  shift.resize(static_cast<std::size_t>(m)), reach.resize(static_cast<std::size_t>(m));
   double S = 0, U = std::numeric_limits<double>::infinity();
   for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < n; ++j) shift[i] += box[j] * A(i, j), reach[i] += box[j] * std::abs(A(i, j));
+    double sh = 0, re = 0;
+    for (int j = 0; j < n; ++j) sh += box[j] * A(i, j), re += box[j] * std::abs(A(i, j));
+    shift[i] = sh, reach[i] = re;
     S = std::max(S, (shift[i] - b[i]) / w[i]);
     U = std::min(U, (b[i] + reach[i]) / w[i]);
   }
@@ -80,16 +86,17 @@ MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<do
   // the basis and Bland's rule (indices kept in order) takes the same pivots on the rest, with
   // the same arithmetic: the same bits, on a third to a half of the rows (the worst pass's
   // ratio terms far above its minimum).
-  std::vector<int> kept;
-  kept.reserve(m);
+  kept.clear();
   for (int i = 0; i < m; ++i)
     if (!(b[i] - reach[i] > w[i] * U + 1e-9 * (1 + std::abs(w[i] * U)))) kept.push_back(i);
   const int mk = static_cast<int>(kept.size());
   const int rows = mk + n, cols = n + 1;
   // Dictionary form: x_B[i] = q[i] − Σ_j M[i][j] x_N[j], objective z = const + Σ_j c[j] x_N[j].
-  std::vector<double> M(static_cast<std::size_t>(rows) * cols, 0.0), q(rows), c(cols, 0.0);
-  std::vector<int> B(rows), N(cols);
+  M.resize(static_cast<std::size_t>(rows) * cols), q.resize(static_cast<std::size_t>(rows));
+  c.assign(static_cast<std::size_t>(cols), 0.0);
+  B.resize(static_cast<std::size_t>(rows)), N.resize(static_cast<std::size_t>(cols));
   auto at = [&](int i, int j) -> double& { return M[static_cast<std::size_t>(i) * cols + j]; };
+  std::fill(M.begin() + static_cast<std::ptrdiff_t>(mk) * cols, M.begin() + static_cast<std::ptrdiff_t>(rows) * cols, 0.0);
   for (int r = 0; r < mk; ++r) {
     const int i = kept[static_cast<std::size_t>(r)];
     for (int j = 0; j < n; ++j) at(r, j) = -box[j] * A(i, j);
@@ -153,12 +160,15 @@ MaxMinN max_min_affine(int n, const std::vector<double>& a, const std::vector<do
 }
 
 MaxMin max_min_affine(const std::vector<Affine>& f, const std::vector<double>& w, double box) {
-  std::vector<double> a(3 * f.size()), b(f.size());
+  thread_local std::vector<double> a, b;
+  a.resize(3 * f.size()), b.resize(f.size());
   for (std::size_t i = 0; i < f.size(); ++i) {
     for (int j = 0; j < 3; ++j) a[3 * i + j] = f[i].a[j];
     b[i] = f[i].b;
   }
-  const MaxMinN r = max_min_affine(3, a, b, w, {box, box, box});
+  thread_local std::vector<double> boxes(3);
+  boxes.assign(3, box);
+  const MaxMinN r = max_min_affine(3, a, b, w, boxes);
   MaxMin out;
   if (!r.ok) return out;
   out.d = Vec3(r.d[0], r.d[1], r.d[2]);

@@ -107,9 +107,9 @@ void ratio_terms(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3&
 // as its value and gradient in that position (scaled_frame). Verdict's hex value is the
 // minimum of these and of the frames v is not in. With `value_only`, the gradients are left
 // zero; with `norms` (ratio_norms()), ratio_terms() come too.
-std::vector<Affine> frame_values(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x,
-                                      bool value_only, const std::vector<double>* norms) {
-  std::vector<Affine> out;
+void frame_values(const HexMesh& mesh, const Incidence& inc, Index v, const Vec3& x, bool value_only,
+                  const std::vector<double>* norms, std::vector<Affine>& out) {
+  out.clear();
   if (norms) ratio_terms(mesh, inc, v, x, value_only, *norms, out);
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
@@ -122,7 +122,6 @@ std::vector<Affine> frame_values(const HexMesh& mesh, const Incidence& inc, Inde
       if (!c.isZero()) out.push_back(scaled_frame(frame(p, t, 1.0), c, value_only));
     }
   }
-  return out;
 }
 
 double lowest(const std::vector<Affine>& f) {
@@ -181,17 +180,20 @@ bool worst_move(HexMesh& mesh, const Incidence& inc, Index v, const std::vector<
     double now;          // the smallest term to raise
     std::size_t raised;  // the terms to raise come first; the constraints follow them
   };
-  const auto terms = [&](const Vec3& y, bool value_only) {
-    Model m{frame_values(mesh, inc, v, y, value_only, std::isnan(held_ratio) ? ratio : nullptr), {}, 0, 0};
-    m.now = lowest(m.f);
-    m.raised = m.f.size();
-    m.w.assign(m.f.size(), 1.0);
+  // The model at x and a trial's, in per-thread buffers (a move runs to its end on its thread;
+  // their allocations were a twentieth of the pass's instructions).
+  thread_local Model m, my;
+  thread_local std::vector<Affine> held;
+  const auto terms = [&](const Vec3& y, bool value_only, Model& out) {
+    frame_values(mesh, inc, v, y, value_only, std::isnan(held_ratio) ? ratio : nullptr, out.f);
+    out.now = lowest(out.f);
+    out.raised = out.f.size();
+    out.w.assign(out.f.size(), 1.0);
     if (!std::isnan(held_ratio)) {
-      std::vector<Affine> r;
-      ratio_terms(mesh, inc, v, y, value_only, norms, r);
-      for (Affine& a : r) a.b -= held_ratio, m.f.push_back(a), m.w.push_back(1e-6);
+      held.clear();
+      ratio_terms(mesh, inc, v, y, value_only, norms, held);
+      for (Affine& a : held) a.b -= held_ratio, out.f.push_back(a), out.w.push_back(1e-6);
     }
-    return m;
   };
   for (int phase = 1; phase <= (options.ratio_terms ? 2 : 1); ++phase) {
     if (phase == 2) {
@@ -202,7 +204,7 @@ bool worst_move(HexMesh& mesh, const Incidence& inc, Index v, const std::vector<
     }
     double box = options.step * len;
     for (int model = 0; model < options.models; ++model) {
-      Model m = terms(x, false);
+      terms(x, false, m);
       std::vector<Affine>& f = m.f;
       std::vector<double>& w = m.w;
       const double now = m.now;
@@ -236,7 +238,7 @@ bool worst_move(HexMesh& mesh, const Incidence& inc, Index v, const std::vector<
         const double q =
             local_min(mesh, inc, v, y, &valid, &below, &start, options.min_edge_shrink, &ratio_y, &edges_y, &limits);
         if (!valid || below > below0 || q < sj_floor || ratio_y < ratio_floor || edges_y > edge_cap) continue;
-        const Model my = terms(y, true);
+        terms(y, true, my);
         if (!(my.now > now + 1e-9)) continue;
         // Phase 2: the ratio terms held, and the certified ratio around v too; the scaled
         // Jacobian it raises may not fall.
