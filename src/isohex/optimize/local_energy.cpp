@@ -192,10 +192,12 @@ RelativeCorners relative_corners(const std::array<Vec3, 8>& p) {
   return d;
 }
 
-Mat3 interior_frame(const RelativeCorners& d, int t, double inv_len) {
+Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
   // Σ_k (P_k − P_0) c_{t,k}ᵀ (Σ c_k = 0: relative to P0), entry by entry in k order, then
   // scaled: the arithmetic of the matrix expression `A += (P_k − P_0) c_kᵀ`, whose
   // temporaries on the stack stalled every load (most of frame()'s samples on cthead).
+  // (interior_frames() gives all of a hex's at once, the same bits.)
+  const RelativeCorners d = relative_corners(p);
   double a[3][3] = {};
   for (const CoefEntry& e : kCoefEntries[static_cast<std::size_t>(t)])
     for (int i = 0; i < 3; ++i) a[i][e.j] += d[e.k][i] * e.c;
@@ -203,10 +205,6 @@ Mat3 interior_frame(const RelativeCorners& d, int t, double inv_len) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) A(i, j) = a[i][j] * inv_len;
   return A;
-}
-
-Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len) {
-  return interior_frame(relative_corners(p), t, inv_len);
 }
 
 double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyParams& params, double eps, int frames) {

@@ -115,9 +115,6 @@ Mat3 interior_frame(const std::array<Vec3, 8>& p, int t, double inv_len);
 /// Corners p relative to p[0], entry by entry: what the interior frames are made of.
 using RelativeCorners = std::array<std::array<double, 3>, 8>;
 RelativeCorners relative_corners(const std::array<Vec3, 8>& p);
-/// interior_frame() from relative_corners(p), the same bits: one subtraction of the corners
-/// for all of a hex's interior frames.
-Mat3 interior_frame(const RelativeCorners& d, int t, double inv_len);
 /// All interior frames of a hex at once, A[t − kFrames] = interior_frame(d, t, inv_len) bit for
 /// bit (four frames at a time); without `gauss`, those of the 3×3×3 lattice only (the 8 Gauss
 /// points' A[0..7] left unset).
