@@ -41,7 +41,7 @@ template <bool kUntangle>
   const d4 gF0 = ((il2 * a0) * c0 + (il2 * a3) * c1) + (il2 * a6) * c2;
   const d4 gF1 = ((il2 * a1) * c0 + (il2 * a4) * c1) + (il2 * a7) * c2;
   const d4 gF2 = (il2 * a2) * c0 + ((il2 * a5) * c1 + (il2 * a8) * c2);
-  // ∇D = il·(c0·(a1 × a2) + c1·(a2 × a0) + c2·(a0 × a1)), a_j the columns
+  // ∇D = il·(c0·(col1 × col2) + c1·(col2 × col0) + c2·(col0 × col1)), with A(r, c) = a[r + 3c]
   const d4 x0 = a4 * a8 - a5 * a7, x1 = a5 * a6 - a3 * a8, x2 = a3 * a7 - a4 * a6;
   const d4 y0 = a7 * a2 - a8 * a1, y1 = a8 * a0 - a6 * a2, y2 = a6 * a1 - a7 * a0;
   const d4 z0 = a1 * a5 - a2 * a4, z1 = a2 * a3 - a0 * a5, z2 = a0 * a4 - a1 * a3;
