@@ -2,6 +2,7 @@
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/generate.hpp"
 #include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/feasibility.hpp"
 #include "isohex/optimize/frame_terms.hpp"
 #include "isohex/optimize/local_energy.hpp"
 #include "isohex/optimize/optimize.hpp"
@@ -162,6 +163,41 @@ TEST(OptimizeShape, InteriorFramesAtOnceGiveEachFramesBits) {
       opt::interior_frames(opt::relative_corners(p), il, A, gauss);
       for (int t = gauss ? opt::kFrames : opt::kFrames + 8; t < opt::kAllFrames; ++t)
         EXPECT_EQ(A[static_cast<std::size_t>(t - opt::kFrames)], opt::interior_frame(p, t, il)) << trial << " " << t;
+    }
+  }
+}
+
+// ratio_coefficients() (the lattice's determinants and gradients four frames at a time)
+// against the frame-by-frame formula: each lattice frame's determinant and det_gradient() of
+// each asked corner, scaled, through lattice_to_bernstein(); the same bits.
+TEST(OptimizeShape, RatioCoefficientsGiveTheFrameByFrameBits) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  const HexMesh cube = box_mesh(1, 1, 1);
+  const std::array<int, 27>& lattice = opt::lattice_frames();
+  for (int trial = 0; trial < 100; ++trial) {
+    std::array<Vec3, 8> p = cube.corners(0);
+    for (Vec3& x : p) x += Vec3(u(rng), u(rng), u(rng));
+    std::array<bool, 8> corners{};
+    corners[static_cast<std::size_t>(trial % 8)] = true;
+    corners[static_cast<std::size_t>((trial * 3 + 1) % 8)] = true;
+    const double weight = 2, norm = 0.7 + u(rng);
+    std::array<double, 27> b;
+    std::array<std::array<Vec3, 27>, 8> g;
+    opt::ratio_coefficients(p, weight, norm, corners, b, &g);
+    std::array<double, 27> rb;
+    for (int n = 0; n < 27; ++n) rb[n] = weight * opt::frame(p, lattice[n], 1.0).determinant() / norm;
+    lattice_to_bernstein(rb);
+    EXPECT_EQ(b, rb) << trial;
+    for (int k = 0; k < 8; ++k) {
+      if (!corners[static_cast<std::size_t>(k)]) continue;
+      std::array<std::array<double, 27>, 3> rg;
+      for (int n = 0; n < 27; ++n) {
+        const Vec3 d = (weight / norm) * opt::det_gradient(opt::frame(p, lattice[n], 1.0), opt::frame_coefficient(lattice[n], k));
+        for (int j = 0; j < 3; ++j) rg[j][n] = d[j];
+      }
+      for (auto& c : rg) lattice_to_bernstein(c);
+      for (int n = 0; n < 27; ++n) EXPECT_EQ(g[k][n], Vec3(rg[0][n], rg[1][n], rg[2][n])) << trial << " " << k << " " << n;
     }
   }
 }

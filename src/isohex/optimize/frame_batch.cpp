@@ -19,6 +19,13 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
   return x;
 }
 [[gnu::always_inline]] inline void store(double* p, d4 x) { std::memcpy(p, &x, sizeof x); }
+// (Helpers, not lambdas: a lambda's call operator is one function for both instruction sets'
+// kernels, and one taking or returning a vector would change its ABI between them.)
+[[gnu::always_inline]] inline d4 field(const double* block, int f) { return load(block + f * 4); }
+[[gnu::always_inline]] inline void set_field(double* block, int f, d4 x) { store(block + f * 4, x); }
+[[gnu::always_inline]] inline d4 lanes(int block, const std::array<double, LatticeFrames::kLanes>& x) {
+  return load(&x[static_cast<std::size_t>(4 * block)]);
+}
 
 // One block of four frames. Each expression is the one the scalar code evaluated (Eigen's
 // orders for a 3×3 matrix's squaredNorm(), determinant(), A·c and cross products; the
@@ -27,12 +34,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 template <bool kUntangle>
 [[gnu::always_inline]] inline void frame_block(double* b, double lambda) {
   using F_ = FrameBatch;
-  const auto in = [&](int field) { return load(b + field * 4); };
-  const auto out = [&](int field, d4 x) { store(b + field * 4, x); };
-  const d4 a0 = in(F_::kA), a1 = in(F_::kA + 1), a2 = in(F_::kA + 2), a3 = in(F_::kA + 3), a4 = in(F_::kA + 4),
-           a5 = in(F_::kA + 5), a6 = in(F_::kA + 6), a7 = in(F_::kA + 7), a8 = in(F_::kA + 8);
-  const d4 c0 = in(F_::kC), c1 = in(F_::kC + 1), c2 = in(F_::kC + 2);
-  const d4 il = in(F_::kIl), sq = in(F_::kSq);
+  const d4 a0 = field(b, F_::kA), a1 = field(b, F_::kA + 1), a2 = field(b, F_::kA + 2), a3 = field(b, F_::kA + 3), a4 = field(b, F_::kA + 4),
+           a5 = field(b, F_::kA + 5), a6 = field(b, F_::kA + 6), a7 = field(b, F_::kA + 7), a8 = field(b, F_::kA + 8);
+  const d4 c0 = field(b, F_::kC), c1 = field(b, F_::kC + 1), c2 = field(b, F_::kC + 2);
+  const d4 il = field(b, F_::kIl), sq = field(b, F_::kSq);
   const d4 F = (((a0 * a0 + a2 * a2) + (a4 * a4 + a6 * a6)) + ((a1 * a1 + a3 * a3) + (a5 * a5 + a7 * a7))) + a8 * a8;
   const d4 D = (a0 * (a4 * a8 - a7 * a5) - a3 * (a1 * a8 - a7 * a2)) + a6 * (a1 * a5 - a4 * a2);
   // ∇F = 2·il·A·c (Eigen's scaled product: the factor on A's entries, rows 0 and 1 summed left
@@ -49,20 +54,20 @@ template <bool kUntangle>
   const d4 gD1 = il * ((c0 * x1 + c1 * y1) + c2 * z1);
   const d4 gD2 = il * ((c0 * x2 + c1 * y2) + c2 * z2);
   TermValue<d4> s;
-  if constexpr (kUntangle) s = untangle_term(F, D, in(F_::kEps), lambda);
+  if constexpr (kUntangle) s = untangle_term(F, D, field(b, F_::kEps), lambda);
   else s = shape_term(F, D);
-  out(F_::kF, F), out(F_::kD, D), out(F_::kValue, s.f);
-  out(F_::kGrad, s.fF * gF0 + s.fD * gD0);
-  out(F_::kGrad + 1, s.fF * gF1 + s.fD * gD1);
-  out(F_::kGrad + 2, s.fF * gF2 + s.fD * gD2);
-  out(F_::kIdentity, s.fF * 2.0 * il * il * sq);
+  set_field(b, F_::kF, F), set_field(b, F_::kD, D), set_field(b, F_::kValue, s.f);
+  set_field(b, F_::kGrad, s.fF * gF0 + s.fD * gD0);
+  set_field(b, F_::kGrad + 1, s.fF * gF1 + s.fD * gD1);
+  set_field(b, F_::kGrad + 2, s.fF * gF2 + s.fD * gD2);
+  set_field(b, F_::kIdentity, s.fF * 2.0 * il * il * sq);
   const d4 gF[3] = {gF0, gF1, gF2}, gD[3] = {gD0, gD1, gD2};
   int e = F_::kHessian;
   for (int j = 0; j < 3; ++j)
-    for (int i = j; i < 3; ++i) out(e++, s.fFD * (gF[i] * gD[j] + gD[i] * gF[j]) + (s.fDD * gD[i]) * gD[j]);
-  out(F_::kGF, gF0), out(F_::kGF + 1, gF1), out(F_::kGF + 2, gF2);
-  out(F_::kGD, gD0), out(F_::kGD + 1, gD1), out(F_::kGD + 2, gD2);
-  out(F_::kCc, il * il * sq);
+    for (int i = j; i < 3; ++i) set_field(b, e++, s.fFD * (gF[i] * gD[j] + gD[i] * gF[j]) + (s.fDD * gD[i]) * gD[j]);
+  set_field(b, F_::kGF, gF0), set_field(b, F_::kGF + 1, gF1), set_field(b, F_::kGF + 2, gF2);
+  set_field(b, F_::kGD, gD0), set_field(b, F_::kGD + 1, gD1), set_field(b, F_::kGD + 2, gD2);
+  set_field(b, F_::kCc, il * il * sq);
 }
 
 [[gnu::always_inline]] inline void frames_body(double* data, std::size_t blocks, bool untangle, double lambda) {
@@ -76,14 +81,13 @@ template <bool kUntangle>
 template <bool kUntangle>
 [[gnu::always_inline]] inline d4 model_block(const double* b, const Vec3& d, double dd, double lambda) {
   using M = FrameBatch;
-  const auto in = [&](int field) { return load(b + field * 4); };
-  const d4 D = in(M::kD) + ((in(M::kGD) * d[0] + in(M::kGD + 1) * d[1]) + in(M::kGD + 2) * d[2]);
-  const d4 F = (in(M::kF) + ((in(M::kGF) * d[0] + in(M::kGF + 1) * d[1]) + in(M::kGF + 2) * d[2])) + in(M::kCc) * dd;
+  const d4 D = field(b, M::kD) + ((field(b, M::kGD) * d[0] + field(b, M::kGD + 1) * d[1]) + field(b, M::kGD + 2) * d[2]);
+  const d4 F = (field(b, M::kF) + ((field(b, M::kGF) * d[0] + field(b, M::kGF + 1) * d[1]) + field(b, M::kGF + 2) * d[2])) + field(b, M::kCc) * dd;
   if constexpr (kUntangle) {
-    return untangle_term(F, D, in(M::kEps), lambda).f;
+    return untangle_term(F, D, field(b, M::kEps), lambda).f;
   } else {
     const d4 constraint = D > kMinFeasibleDet ? splat<d4>(0.0) : splat<d4>(kInf);
-    return in(M::kConstraint) != 0.0 ? constraint : shape_term(F, D).f;
+    return field(b, M::kConstraint) != 0.0 ? constraint : shape_term(F, D).f;
   }
 }
 
@@ -135,6 +139,24 @@ const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
   }
 }
 
+// Determinants and det_gradient()s of up to 28 frames, four at a time, in the orders of Eigen's determinant() and of det_gradient()'s
+// expression: the same bits.
+[[gnu::always_inline]] inline void lattice_body(LatticeFrames& f, bool gradients) {
+  for (int b = 0; b < LatticeFrames::kBlocks; ++b) {
+    const d4 a0 = lanes(b, f.a[0]), a1 = lanes(b, f.a[1]), a2 = lanes(b, f.a[2]), a3 = lanes(b, f.a[3]),
+             a4 = lanes(b, f.a[4]), a5 = lanes(b, f.a[5]), a6 = lanes(b, f.a[6]), a7 = lanes(b, f.a[7]),
+             a8 = lanes(b, f.a[8]);
+    store(&f.det[static_cast<std::size_t>(4 * b)],
+          (a0 * (a4 * a8 - a7 * a5) - a3 * (a1 * a8 - a7 * a2)) + a6 * (a1 * a5 - a4 * a2));
+    if (!gradients) continue;
+    const d4 c0 = lanes(b, f.c[0]), c1 = lanes(b, f.c[1]), c2 = lanes(b, f.c[2]);
+    const d4 x[3] = {a4 * a8 - a5 * a7, a5 * a6 - a3 * a8, a3 * a7 - a4 * a6};  // col1 × col2
+    const d4 y[3] = {a7 * a2 - a8 * a1, a8 * a0 - a6 * a2, a6 * a1 - a7 * a0};  // col2 × col0
+    const d4 z[3] = {a1 * a5 - a2 * a4, a2 * a3 - a0 * a5, a0 * a4 - a1 * a3};  // col0 × col1
+    for (int i = 0; i < 3; ++i) store(&f.grad[i][static_cast<std::size_t>(4 * b)], (c0 * x[i] + c1 * y[i]) + c2 * z[i]);
+  }
+}
+
 #if ISOHEX_HAVE_FMV
 // AVX2 where the CPU has it (no FMA: the same bits as the baseline's SSE2 pairs).
 [[gnu::target("default")]] void frames_kernel(double* data, std::size_t blocks, bool untangle, double lambda) {
@@ -157,7 +179,10 @@ const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
 [[gnu::target("avx2")]] void interior_kernel(const RelativeCorners& d, double inv_len, Mat3* out, int first) {
   interior_body(d, inv_len, out, first);
 }
+[[gnu::target("default")]] void lattice_kernel(LatticeFrames& f, bool gradients) { lattice_body(f, gradients); }
+[[gnu::target("avx2")]] void lattice_kernel(LatticeFrames& f, bool gradients) { lattice_body(f, gradients); }
 #else
+void lattice_kernel(LatticeFrames& f, bool gradients) { lattice_body(f, gradients); }
 void interior_kernel(const RelativeCorners& d, double inv_len, Mat3* out, int first) {
   interior_body(d, inv_len, out, first);
 }
@@ -186,6 +211,8 @@ void FrameBatch::compute(bool untangle, double lambda) {
 }
 
 void TermModels::seal() { pad(terms); }
+
+void LatticeFrames::compute(bool gradients) { lattice_kernel(*this, gradients); }
 
 void interior_frames(const RelativeCorners& d, double inv_len, InteriorFrames& out, bool gauss) {
   // Frames 9..16 are the Gauss points (local_energy.hpp): the first two blocks.

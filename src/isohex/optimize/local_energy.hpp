@@ -230,6 +230,21 @@ struct FrameBatch {
   void compute(bool untangle, double lambda);
 };
 
+/// Up to 28 frames field by field (the 27 of the Bernstein lattice, a spare lane), and what
+/// compute() makes of them four at a time: each frame's determinant (Eigen's determinant(), bit
+/// for bit) and, with `gradients`, det_gradient(A, c) of its coefficient c.
+struct LatticeFrames {
+  static constexpr int kLanes = 28, kBlocks = 7;
+  std::array<std::array<double, kLanes>, 9> a{};  ///< A(r, c) at a[r + 3c]
+  std::array<std::array<double, kLanes>, 3> c{};
+  std::array<double, kLanes> det{};
+  std::array<std::array<double, kLanes>, 3> grad{};
+  void set_frame(int n, const Mat3& A) {
+    for (int e = 0; e < 9; ++e) a[static_cast<std::size_t>(e)][static_cast<std::size_t>(n)] = A.data()[e];
+  }
+  void compute(bool gradients);
+};
+
 /// The terms of a vertex's energy as functions of the vertex's displacement d from where they
 /// were recorded: a frame changes by the rank-one il·d·cᵀ, so its F = |A|² is F0 + gF·d +
 /// cc·|d|² and its D = det A is D0 + gD·d, exactly (a Bernstein coefficient is affine alike).
