@@ -216,21 +216,22 @@ void ratio_coefficients(const std::array<Vec3, 8>& p, double weight, double norm
     const int t = lattice[static_cast<std::size_t>(n)];
     lf.set_frame(n, t > kCentreFrame ? interior[static_cast<std::size_t>(t - kFrames)] : frame(p, t, 1.0));
   }
-  bool first = true;
-  for (int k = 0; k < 8; ++k) {
-    if (!(g && corners[k]) && !(first && k == 7)) continue;  // the determinants with the first corner (or alone)
-    const bool grads = g && corners[k];
-    for (int n = 0; grads && n < 27; ++n) {
+  // Each asked corner's gradients (the determinants come with them, the same each time), or
+  // the determinants alone.
+  bool dets = false;
+  for (int k = 0; g && k < 8; ++k) {
+    if (!corners[k]) continue;
+    for (int n = 0; n < 27; ++n) {
       const Vec3& c = frame_coefficient(lattice[static_cast<std::size_t>(n)], k);
       for (int j = 0; j < 3; ++j) lf.c[static_cast<std::size_t>(j)][static_cast<std::size_t>(n)] = c[j];
     }
-    lf.compute(grads);
-    if (first)
-      for (int n = 0; n < 27; ++n) b[n] = weight * lf.det[static_cast<std::size_t>(n)] / norm;
-    first = false;
-    for (int n = 0; grads && n < 27; ++n)
+    lf.compute(true);
+    dets = true;
+    for (int n = 0; n < 27; ++n)
       for (int j = 0; j < 3; ++j) gk[k][j][n] = (weight / norm) * lf.grad[static_cast<std::size_t>(j)][static_cast<std::size_t>(n)];
   }
+  if (!dets) lf.compute(false);
+  for (int n = 0; n < 27; ++n) b[n] = weight * lf.det[static_cast<std::size_t>(n)] / norm;
   lattice_to_bernstein(b);
   if (!g) return;
   for (int k = 0; k < 8; ++k) {

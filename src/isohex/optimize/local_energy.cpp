@@ -269,6 +269,7 @@ struct HexFrames {
   int k;
   double il, eps;
   std::size_t first, last;
+  bool bernstein;  // the hex also counts det J's Bernstein coefficients
 };
 
 }  // namespace
@@ -292,7 +293,7 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     int k = 0;
     while (mesh.hexes[h][k] != v) ++k;
     p[k] = x;
-    HexFrames hf{h, k, inv_len[h], params.eps_of(h), batch.size, 0};
+    HexFrames hf{h, k, inv_len[h], params.eps_of(h), batch.size, 0, params.bernstein_of(h)};
     const int frames = params.frames_of(h);
     InteriorFrames interior;  // the hex's 26 interior frames, at once
     if (frames > kFrames) interior_frames(relative_corners(p), hf.il, interior);
@@ -314,7 +315,7 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     }
     hf.last = batch.size;
     hexes.push_back(hf);
-    bernstein = bernstein || params.bernstein_of(h);
+    bernstein = bernstein || hf.bernstein;
   }
   batch.compute(params.untangle, params.lambda);
   // The sums in frame order, hex by hex (a hex's Bernstein terms after its frames): those of
@@ -344,7 +345,7 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
         for (int r = c; r < 3; ++r) (*H)(r, c) += batch.at(j, n++);
       }
     }
-    if (params.bernstein_of(hf.h)) {
+    if (hf.bernstein) {
       std::array<Vec3, 8> p = mesh.corners(hf.h);
       p[hf.k] = x;
       e += bernstein_energy(p, hf.k, hf.il, params, hf.eps, g, H, model);
