@@ -8,6 +8,10 @@
 //
 // The library keeps global state (its options and last error message), so every call into
 // it holds one mutex. Its failures become isohex::Error naming the file and the step.
+//
+// It is opened on first use (dlopen), not linked: it pulls in some fifty shared libraries
+// (netCDF, HDF5, Open MPI, GnuTLS, ICU, ...) whose loading was 25 of the 28 ms that every
+// isohex command took to start (`isohex --version`), though few runs touch an Exodus file.
 
 #include "isohex/error.hpp"
 #include "isohex/io/format_support.hpp"
@@ -19,6 +23,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <dlfcn.h>
 #include <cmath>
 #include <mutex>
 #include <numeric>
@@ -37,12 +42,56 @@ std::mutex& exodus_mutex() {
   return m;
 }
 
+// The library's functions this file calls, with their declared types.
+#define ISOHEX_EXODUS_FUNCTIONS(X)                                                                                \
+  X(ex_create_int) X(ex_open_int) X(ex_close) X(ex_opts) X(ex_get_err) X(ex_put_init) X(ex_put_coord)             \
+  X(ex_put_coord_names) X(ex_put_elem_block) X(ex_put_elem_conn) X(ex_put_names) X(ex_put_id_map)                 \
+  X(ex_put_side_set_param) X(ex_put_side_set) X(ex_put_node_set_param) X(ex_put_node_set) X(ex_get_names)        \
+  X(ex_get_init) X(ex_get_coord) X(ex_get_id_map) X(ex_get_ids) X(ex_get_elem_block) X(ex_get_elem_conn)         \
+  X(ex_get_node_set_param) X(ex_get_node_set)
+
+struct ExodusApi {
+#define ISOHEX_EXODUS_MEMBER(f) decltype(&::f) f = nullptr;
+  ISOHEX_EXODUS_FUNCTIONS(ISOHEX_EXODUS_MEMBER)
+#undef ISOHEX_EXODUS_MEMBER
+};
+
+const ExodusApi* loaded_api = nullptr;  // set by load_exodus(), under exodus_mutex()
+
+/// Opens the library once (the caller holds exodus_mutex()); throws, naming `file`, where it
+/// cannot be loaded.
+void load_exodus(const fs::path& file) {
+  static ExodusApi table;
+  static std::string failure;
+  static bool tried = false;
+  if (!tried) {
+    tried = true;
+    // Never closed: the library's atexit handlers and buffers live as long as the process.
+    if (void* lib = dlopen(ISOHEX_EXODUS_LIBRARY, RTLD_NOW | RTLD_LOCAL); !lib) {
+      const char* why = dlerror();
+      failure = fmt::format("cannot load {} (Debian package libexodusii5): {}", ISOHEX_EXODUS_LIBRARY,
+                            why ? why : "unknown error");
+    } else {
+#define ISOHEX_EXODUS_BIND(f)                                                                  \
+  table.f = reinterpret_cast<decltype(&::f)>(dlsym(lib, #f));                                     \
+  if (!table.f && failure.empty()) failure = fmt::format("{} has no function {}", ISOHEX_EXODUS_LIBRARY, #f);
+      ISOHEX_EXODUS_FUNCTIONS(ISOHEX_EXODUS_BIND)
+#undef ISOHEX_EXODUS_BIND
+    }
+    if (failure.empty()) loaded_api = &table;
+  }
+  if (!loaded_api) throw Error(fmt::format("{}: Exodus II is not available: {}", file.string(), failure));
+}
+
+/// The library's functions, once load_exodus() has succeeded.
+const ExodusApi& api() { return *loaded_api; }
+
 /// The library's last error message, for an exception.
 std::string last_exodus_error() {
   const char* msg = nullptr;
   const char* func = nullptr;
   int code = 0;
-  ex_get_err(&msg, &func, &code);
+  api().ex_get_err(&msg, &func, &code);
   std::string out = msg && *msg ? msg : "unknown error";
   if (func && *func) out += fmt::format(" (in {})", func);
   return out;
@@ -60,14 +109,14 @@ class ExodusFile {
   ExodusFile(const ExodusFile&) = delete;
   ExodusFile& operator=(const ExodusFile&) = delete;
   ~ExodusFile() {
-    if (id_ >= 0) ex_close(id_);
+    if (id_ >= 0) api().ex_close(id_);
   }
   [[nodiscard]] int id() const { return id_; }
   /// Closes now, reporting a failure (the final flush happens here).
   void close(const fs::path& file) {
     const int id = id_;
     id_ = -1;
-    check(ex_close(id), file, "closing");
+    check(api().ex_close(id), file, "closing");
   }
 
  private:
@@ -91,7 +140,7 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
   int comp_ws = 8, io_ws = 8;  // doubles in memory and in the file
   // Classic netCDF (64-bit offsets), not netCDF-4/HDF5: its bytes depend only on the data,
   // so the output is deterministic, and every Exodus reader handles it.
-  const int id = ex_create(tmp.c_str(), EX_CLOBBER | EX_LARGE_MODEL, &comp_ws, &io_ws);
+  const int id = api().ex_create_int(tmp.c_str(), EX_CLOBBER | EX_LARGE_MODEL, &comp_ws, &io_ws, EX_API_VERS_NODOT);
   if (id < 0) throw Error(fmt::format("{}: Exodus II: cannot create the file: {}", file.string(), last_exodus_error()));
   ExodusFile exo(id);
 
@@ -102,7 +151,7 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
   for (std::size_t v = 0; v < mesh.fixed.size(); ++v)
     if (mesh.fixed[v]) fixed_nodes.push_back(static_cast<int>(v) + 1);
   const int num_node_sets = (bnodes.empty() ? 0 : 1) + (fixed_nodes.empty() ? 0 : 1);
-  check(ex_put_init(id, "isohex hex mesh", 3, mesh.num_vertices(), mesh.num_hexes(),
+  check(api().ex_put_init(id, "isohex hex mesh", 3, mesh.num_vertices(), mesh.num_hexes(),
                     static_cast<int64_t>(blocks.values.size()), num_node_sets, faces.empty() ? 0 : 1),
         file, "writing the header");
 
@@ -112,10 +161,10 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
       xyz[d].reserve(mesh.points.size());
       for (const Vec3& p : mesh.points) xyz[d].push_back(p[d]);
     }
-    check(ex_put_coord(id, xyz[0].data(), xyz[1].data(), xyz[2].data()), file, "writing the coordinates");
+    check(api().ex_put_coord(id, xyz[0].data(), xyz[1].data(), xyz[2].data()), file, "writing the coordinates");
     std::vector<std::string> axes = {"x", "y", "z"};
     NameList axis_names(axes);
-    check(ex_put_coord_names(id, axis_names.get()), file, "writing the coordinate names");
+    check(api().ex_put_coord_names(id, axis_names.get()), file, "writing the coordinate names");
   }
 
   // Elements block by block (hex order within a block); file position -> hex.
@@ -131,17 +180,17 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
     for (; at < order.size() && blocks.of_hex[order[at]] == static_cast<Index>(b); ++at)
       for (const Index v : mesh.hexes[order[at]]) conn.push_back(v + 1);
     const ex_entity_id bid = blocks.file_ids[b];
-    check(ex_put_elem_block(id, bid, "HEX8", static_cast<int64_t>(conn.size() / 8), 8, 0), file,
+    check(api().ex_put_elem_block(id, bid, "HEX8", static_cast<int64_t>(conn.size() / 8), 8, 0), file,
           fmt::format("writing element block {}", bid));
-    check(ex_put_elem_conn(id, bid, conn.data()), file, fmt::format("writing element block {}", bid));
+    check(api().ex_put_elem_conn(id, bid, conn.data()), file, fmt::format("writing element block {}", bid));
     names.push_back(block_name(blocks.values[b]));
   }
   if (!names.empty()) {
     NameList block_names(names);
-    check(ex_put_names(id, EX_ELEM_BLOCK, block_names.get()), file, "writing the block names");
+    check(api().ex_put_names(id, EX_ELEM_BLOCK, block_names.get()), file, "writing the block names");
     std::vector<int> map(order.size());
     for (std::size_t i = 0; i < order.size(); ++i) map[i] = order[i] + 1;
-    check(ex_put_id_map(id, EX_ELEM_MAP, map.data()), file, "writing the element id map");
+    check(api().ex_put_id_map(id, EX_ELEM_MAP, map.data()), file, "writing the element id map");
   }
 
   if (!faces.empty()) {
@@ -150,19 +199,19 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
       elems.push_back(position_of_hex[f.hex]);
       sides.push_back(kExodusSideOfVtkFace[f.face]);
     }
-    check(ex_put_side_set_param(id, 1, static_cast<int64_t>(faces.size()), 0), file, "writing the side set");
-    check(ex_put_side_set(id, 1, elems.data(), sides.data()), file, "writing the side set");
+    check(api().ex_put_side_set_param(id, 1, static_cast<int64_t>(faces.size()), 0), file, "writing the side set");
+    check(api().ex_put_side_set(id, 1, elems.data(), sides.data()), file, "writing the side set");
     std::vector<std::string> sset = {"boundary"};
     NameList sset_names(sset);
-    check(ex_put_names(id, EX_SIDE_SET, sset_names.get()), file, "writing the side set name");
+    check(api().ex_put_names(id, EX_SIDE_SET, sset_names.get()), file, "writing the side set name");
   }
 
   std::vector<std::string> nset;
   ex_entity_id next_set = 1;
   auto put_node_set = [&](const std::vector<int>& nodes, const char* name) {
-    check(ex_put_node_set_param(id, next_set, static_cast<int64_t>(nodes.size()), 0), file,
+    check(api().ex_put_node_set_param(id, next_set, static_cast<int64_t>(nodes.size()), 0), file,
           fmt::format("writing node set {}", name));
-    check(ex_put_node_set(id, next_set, nodes.data()), file, fmt::format("writing node set {}", name));
+    check(api().ex_put_node_set(id, next_set, nodes.data()), file, fmt::format("writing node set {}", name));
     nset.emplace_back(name);
     ++next_set;
   };
@@ -174,7 +223,7 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
   if (!fixed_nodes.empty()) put_node_set(fixed_nodes, "fixed");
   if (!nset.empty()) {
     NameList nset_names(nset);
-    check(ex_put_names(id, EX_NODE_SET, nset_names.get()), file, "writing the node set names");
+    check(api().ex_put_names(id, EX_NODE_SET, nset_names.get()), file, "writing the node set names");
   }
   exo.close(file);
 }
@@ -186,7 +235,7 @@ std::vector<std::string> entity_names(int id, ex_entity_type type, std::size_t c
   std::vector<std::vector<char>> storage(count, std::vector<char>(kRoom + 1, '\0'));
   std::vector<char*> ptrs;
   for (auto& s : storage) ptrs.push_back(s.data());
-  if (count) check(ex_get_names(id, type, ptrs.data()), file, "reading names");
+  if (count) check(api().ex_get_names(id, type, ptrs.data()), file, "reading names");
   std::vector<std::string> out;
   for (auto& s : storage) out.emplace_back(s.data());
   return out;
@@ -196,14 +245,14 @@ HexMesh read_exodus_file(const fs::path& file, const ReadOptions& options, ReadR
   if (!fs::exists(file)) throw Error(fmt::format("{}: cannot open: no such file", file.string()));
   int comp_ws = 8, io_ws = 0;
   float version = 0;
-  const int id = ex_open(file.c_str(), EX_READ, &comp_ws, &io_ws, &version);
+  const int id = api().ex_open_int(file.c_str(), EX_READ, &comp_ws, &io_ws, &version, EX_API_VERS_NODOT);
   if (id < 0)
     throw Error(fmt::format("{}: not a readable Exodus II file: {}", file.string(), last_exodus_error()));
   ExodusFile exo(id);
 
   char title[MAX_LINE_LENGTH + 1] = {};
   int dim = 0, num_nodes = 0, num_elems = 0, num_blocks = 0, num_nsets = 0, num_ssets = 0;
-  check(ex_get_init(id, title, &dim, &num_nodes, &num_elems, &num_blocks, &num_nsets, &num_ssets), file,
+  check(api().ex_get_init(id, title, &dim, &num_nodes, &num_elems, &num_blocks, &num_nsets, &num_ssets), file,
         "reading the header");
   if (dim != 3) throw Error(fmt::format("{}: Exodus II: the mesh is {}-dimensional, not 3-dimensional", file.string(), dim));
   if (num_nodes < 0 || num_elems < 0 || num_blocks < 0)
@@ -213,7 +262,7 @@ HexMesh read_exodus_file(const fs::path& file, const ReadOptions& options, ReadR
   if (num_nodes > 0) {
     std::vector<double> xyz[3];
     for (auto& c : xyz) c.resize(static_cast<std::size_t>(num_nodes));
-    check(ex_get_coord(id, xyz[0].data(), xyz[1].data(), xyz[2].data()), file, "reading the coordinates");
+    check(api().ex_get_coord(id, xyz[0].data(), xyz[1].data(), xyz[2].data()), file, "reading the coordinates");
     mesh.points.resize(static_cast<std::size_t>(num_nodes));
     for (std::size_t v = 0; v < mesh.points.size(); ++v) {
       mesh.points[v] = Vec3(xyz[0][v], xyz[1][v], xyz[2][v]);
@@ -224,9 +273,9 @@ HexMesh read_exodus_file(const fs::path& file, const ReadOptions& options, ReadR
 
   // Elements in file order; the element id map (1..n when the file has none) orders them.
   std::vector<int> map(static_cast<std::size_t>(num_elems));
-  if (num_elems > 0) check(ex_get_id_map(id, EX_ELEM_MAP, map.data()), file, "reading the element id map");
+  if (num_elems > 0) check(api().ex_get_id_map(id, EX_ELEM_MAP, map.data()), file, "reading the element id map");
   std::vector<int> block_ids(static_cast<std::size_t>(num_blocks));
-  if (num_blocks > 0) check(ex_get_ids(id, EX_ELEM_BLOCK, block_ids.data()), file, "reading the element block ids");
+  if (num_blocks > 0) check(api().ex_get_ids(id, EX_ELEM_BLOCK, block_ids.data()), file, "reading the element block ids");
   const std::vector<std::string> names = entity_names(id, EX_ELEM_BLOCK, block_ids.size(), file);
 
   std::vector<Hex> hexes;
@@ -236,7 +285,7 @@ HexMesh read_exodus_file(const fs::path& file, const ReadOptions& options, ReadR
   for (std::size_t b = 0; b < block_ids.size(); ++b) {
     char type[MAX_STR_LENGTH + 1] = {};
     int count = 0, per = 0, attrs = 0;
-    check(ex_get_elem_block(id, block_ids[b], type, &count, &per, &attrs), file,
+    check(api().ex_get_elem_block(id, block_ids[b], type, &count, &per, &attrs), file,
           fmt::format("reading element block {}", block_ids[b]));
     if (count < 0 || position + static_cast<std::size_t>(count) > map.size())
       throw Error(fmt::format("{}: Exodus II: element block {} holds more elements than the file declares",
@@ -253,7 +302,7 @@ HexMesh read_exodus_file(const fs::path& file, const ReadOptions& options, ReadR
     }
     std::vector<int> conn(static_cast<std::size_t>(count) * 8);
     if (count > 0)
-      check(ex_get_elem_conn(id, block_ids[b], conn.data()), file, fmt::format("reading element block {}", block_ids[b]));
+      check(api().ex_get_elem_conn(id, block_ids[b], conn.data()), file, fmt::format("reading element block {}", block_ids[b]));
     for (int e = 0; e < count; ++e) {
       Hex h;
       for (int k = 0; k < 8; ++k) {
@@ -284,14 +333,14 @@ HexMesh read_exodus_file(const fs::path& file, const ReadOptions& options, ReadR
   // Fixed vertices: the node set named "fixed" (as the writer names it).
   if (num_nsets > 0) {
     std::vector<int> nset_ids(static_cast<std::size_t>(num_nsets));
-    check(ex_get_ids(id, EX_NODE_SET, nset_ids.data()), file, "reading the node set ids");
+    check(api().ex_get_ids(id, EX_NODE_SET, nset_ids.data()), file, "reading the node set ids");
     const std::vector<std::string> nset_names = entity_names(id, EX_NODE_SET, nset_ids.size(), file);
     for (std::size_t s = 0; s < nset_ids.size(); ++s) {
       if (nset_names[s] != "fixed") continue;
       int count = 0, factors = 0;
-      check(ex_get_node_set_param(id, nset_ids[s], &count, &factors), file, "reading node set fixed");
+      check(api().ex_get_node_set_param(id, nset_ids[s], &count, &factors), file, "reading node set fixed");
       std::vector<int> nodes(static_cast<std::size_t>(std::max(count, 0)));
-      if (count > 0) check(ex_get_node_set(id, nset_ids[s], nodes.data()), file, "reading node set fixed");
+      if (count > 0) check(api().ex_get_node_set(id, nset_ids[s], nodes.data()), file, "reading node set fixed");
       mesh.fixed.assign(mesh.points.size(), 0);
       for (const int n : nodes) {
         if (n < 1 || n > num_nodes)
@@ -311,7 +360,8 @@ HexMesh read_exodus_file(const fs::path& file, const ReadOptions& options, ReadR
 HexMesh read_exodus(const fs::path& file, const ReadOptions& options, ReadReport* report) {
   ReadReport local;
   const std::lock_guard lock(exodus_mutex());
-  ex_opts(EX_DEFAULT);  // no printing, no abort: failures are reported by exception
+  load_exodus(file);
+  api().ex_opts(EX_DEFAULT);  // no printing, no abort: failures are reported by exception
   return read_exodus_file(file, options, report ? *report : local);
 }
 
@@ -328,7 +378,8 @@ void write_exodus(const fs::path& file, const HexMesh& mesh, const WriteOptions&
   try {
     {
       const std::lock_guard lock(exodus_mutex());
-      ex_opts(EX_DEFAULT);
+      load_exodus(file);
+      api().ex_opts(EX_DEFAULT);
       write_exodus_file(tmp, file, mesh);
     }
     std::error_code ec;
