@@ -41,6 +41,25 @@ double min_certified_sj(const HexMesh& m) {
   return lo;
 }
 
+// The bone cluster with its free vertices `patch` jittered by up to 0.05 mm (deterministic in
+// `seed`), each kept where it leaves every hex certified.
+HexMesh jittered_bone(unsigned seed, std::vector<Index>& targets, std::vector<Index>& patch) {
+  HexMesh m = bone_cluster(targets);
+  patch.clear();
+  for (Index v = 0; v < m.num_vertices(); ++v)
+    if (!m.fixed[v]) patch.push_back(v);
+  for (Index v : patch) {
+    const Vec3 old = m.points[v];
+    const double a = 0.05 * std::sin(seed * 12.9898 + v * 78.233), b = 0.05 * std::sin(seed * 4.1414 + v * 3.7),
+                 c = 0.05 * std::sin(seed * 9.17 + v * 1.31);
+    m.points[v] = old + Vec3(a, b, c);
+    bool ok = true;
+    for (Index h = 0; h < m.num_hexes(); ++h) ok = ok && certified_valid(m.corners(h), 0.0);
+    if (!ok) m.points[v] = old;
+  }
+  return m;
+}
+
 }  // namespace
 
 // max s with d_i >= s (i < n) and 1 − Σ d_i >= s: every d_i = s = 1/(n + 1).
@@ -107,32 +126,19 @@ TEST(OptimizePatch, JointMovesGoOnWhereSingleMovesStop) {
 // move_patch() on its own: whatever it does, it keeps its guards (property test on jittered
 // pieces of the same cluster).
 TEST(OptimizePatch, MovesKeepTheirGuards) {
-  std::vector<Index> targets;
-  const HexMesh base = bone_cluster(targets);
-  std::vector<Index> patch;
-  for (Index v = 0; v < base.num_vertices(); ++v)
-    if (!base.fixed[v]) patch.push_back(v);
+  std::vector<Index> targets, patch;
   std::size_t moved = 0, moved_guarded = 0;
   for (unsigned seed = 1; seed <= 12; ++seed) {
-    HexMesh m = base;
-    // A small deterministic jitter of the free vertices (0.05 mm), kept where it leaves every
-    // hex certified.
-    for (Index v : patch) {
-      const Vec3 old = m.points[v];
-      const double a = 0.05 * std::sin(seed * 12.9898 + v * 78.233), b = 0.05 * std::sin(seed * 4.1414 + v * 3.7),
-                   c = 0.05 * std::sin(seed * 9.17 + v * 1.31);
-      m.points[v] = old + Vec3(a, b, c);
-      bool ok = true;
-      for (Index h = 0; h < m.num_hexes(); ++h) ok = ok && certified_valid(m.corners(h), 0.0);
-      if (!ok) m.points[v] = old;
-    }
+    HexMesh m = jittered_bone(seed, targets, patch);
     const Incidence inc = vertex_hexes(m);
     const HexMesh before = m;
     const double lo = min_certified_sj(before);
     std::size_t below0 = 0;
     for (Index h = 0; h < m.num_hexes(); ++h) below0 += certified_scaled_jacobian(m.corners(h)) < 0.2;
     // Seeds 7-12: the guarded model (move_patch()'s second try in the worst pass).
-    if (!opt::move_patch(m, inc, targets, patch, before.points, WorstOptions{}, lo, seed > 6)) continue;
+    if (!opt::move_patch(m, inc, targets, patch, before.points, WorstOptions{}, lo,
+                         seed > 6 ? opt::PatchModels::guarded : opt::PatchModels::plain))
+      continue;
     ++moved;
     moved_guarded += seed > 6;
     std::size_t below = 0;
@@ -147,6 +153,37 @@ TEST(OptimizePatch, MovesKeepTheirGuards) {
   }
   EXPECT_GT(moved, moved_guarded);
   EXPECT_GT(moved_guarded, 0u);
+}
+
+// The worst pass's tries (PatchModels::both) leave the mesh as the plain model and, where it
+// gains nothing, the guarded one do, bit for bit: the guarded model is skipped only where it is
+// the plain one's LP (on these pieces, every seed the plain model could not move). Fails if
+// the skip drops a guarded model that differs.
+TEST(OptimizePatch, BothModelsGiveThePlainThenGuardedBits) {
+  std::vector<Index> targets, patch;
+  int plain_failed = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    HexMesh start = jittered_bone(seed, targets, patch);
+    const Incidence inc = vertex_hexes(start);
+    // The plain model's moves until they stop (or five), as the worst pass meets the patch.
+    const std::vector<Vec3> jittered = start.points;
+    for (int k = 0; k < 5 && opt::move_patch(start, inc, targets, patch, jittered, {}, min_certified_sj(start)); ++k) {
+    }
+    const double lo = min_certified_sj(start);
+    for (const double sj_floor : {0.2, 0.3}) {  // the floor decides which rows differ
+      WorstOptions options;
+      options.sj_floor = sj_floor;
+      HexMesh both = start, apart = start;
+      const bool b = opt::move_patch(both, inc, targets, patch, jittered, options, lo, opt::PatchModels::both);
+      bool a = opt::move_patch(apart, inc, targets, patch, jittered, options, lo, opt::PatchModels::plain);
+      plain_failed += !a;
+      a = a || opt::move_patch(apart, inc, targets, patch, jittered, options, lo, opt::PatchModels::guarded);
+      EXPECT_EQ(a, b) << seed;
+      for (Index v = 0; v < start.num_vertices(); ++v)
+        for (int d = 0; d < 3; ++d) EXPECT_EQ(both.points[v][d], apart.points[v][d]) << seed << " " << v;
+    }
+  }
+  EXPECT_GT(plain_failed, 0);
 }
 
 // `isohex smooth --patch-rounds` (the shape stage off, as the band rounds find the cluster): the

@@ -241,7 +241,7 @@ void lp_rows(const Rows& rows, const std::vector<double>& held, const std::vecto
 }  // namespace
 
 bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& targets, const std::vector<Index>& patch,
-                const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min, bool guarded) {
+                const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min, PatchModels models) {
   if (patch.empty()) return false;
   const BoundarySurface* surface = options.surface;
   std::vector<Index> hexes;
@@ -259,78 +259,100 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
                                                                                            : options.max_edge_ratio);
   const double ratio_floor = std::min(before.min_ratio, options.ratio_floor);
   const double sj_floor = std::min(before.min_sj, std::max(options.sj_floor, mesh_min));
-  // The hexes' own frames below this rise; one at the patch's minimum too (were it held at the
-  // floor, the LP would raise the hex's ratio terms instead).
-  const double rise = guarded ? std::max(sj_floor, options.sj_floor) : sj_floor;
-  // The other hexes near the ratio floor hold their largest coefficients down (caps), where the
-  // floor is not the targets' own ratio (then their ratio terms rise, the others' with them):
-  // the caps are the stricter the more a hex's smallest may fall, and blocked the bone's joint
-  // moves (tests/data/bone_cluster.txt) when they held every hex within twice the floor.
-  std::vector<std::uint8_t> caps(hexes.size()), mine(hexes.size());
+  std::vector<std::uint8_t> mine(hexes.size());
   double mine_ratio = 1;
   for (std::size_t i = 0; i < hexes.size(); ++i) {
     mine[i] = std::binary_search(targets.begin(), targets.end(), hexes[i]);
     if (mine[i]) mine_ratio = std::min(mine_ratio, ratios[i]);
   }
-  for (std::size_t i = 0; i < hexes.size(); ++i)
-    caps[i] = guarded && !mine[i] && ratios[i] < 1.25 * ratio_floor && ratio_floor < mine_ratio * (1 - 1e-6);
-  bool moved = false;
-  double scale = options.step;
-  for (int model = 0; model < options.models; ++model) {
-    layout_at(mesh, inc, surface, L);
-    if (L.n == 0) break;
-    const Rows rows = patch_rows(mesh, hexes, norms, mine, caps, L);
-    const double now = lowest(rows, rows, rise);
-    if (!(now < options.target)) break;
-    const std::vector<double> held = hold_levels(rows, ratios, now, sj_floor, rise, ratio_floor, guarded);
-    bool gained = false;
-    for (int trial = 0; trial < options.trials && !gained; ++trial, scale *= 0.5) {
-      std::vector<double> box(static_cast<std::size_t>(L.n));
-      for (std::size_t s = 0; s < patch.size(); ++s)
-        for (int i = 0; i < L.dims[s]; ++i) box[static_cast<std::size_t>(L.off[s] + i)] = scale * L.len[s];
-      std::vector<double> a, b, w;
-      lp_rows(rows, held, box, options.target, a, b, w);
-      const MaxMinN r = max_min_affine(L.n, a, b, w, box);
-      if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model
-      const std::vector<Vec3> x = [&] {
-        std::vector<Vec3> y;
-        for (Index v : patch) y.push_back(mesh.points[v]);
-        return y;
-      }();
-      bool placed = true;
-      for (std::size_t s = 0; s < patch.size() && placed; ++s) {
-        Vec3 y = x[s];
-        for (int i = 0; i < L.dims[s]; ++i) y += r.d[static_cast<std::size_t>(L.off[s] + i)] * L.basis[s][i];
-        if (surface && L.dims[s] > 0 && !surface->put_back(patch[s], y, L.normal[s], L.len[s])) placed = false;
-        mesh.points[patch[s]] = y;
-      }
-      bool ok = false;
-      if (placed) {
-        const Around after = measure(mesh, hexes, L, &sj0, &start, options.min_edge_shrink);
-        ok = after.valid && after.below <= before.below && after.min_sj >= sj_floor && after.min_ratio >= ratio_floor &&
-             after.max_edges <= edge_cap;
-        if (ok) {
-          // The hex's terms rise, and no other term falls below its level or below them (the caps
-          // are the ratio bound's, checked above on the true values).
-          const Rows y = patch_rows(mesh, hexes, norms, mine, caps, L);
-          ok = y.b.size() == rows.b.size();
-          const double raised = ok ? lowest(rows, y, rise) : now;
-          ok = ok && raised > now + 1e-9;
-          for (std::size_t i = 0; ok && i < y.b.size(); ++i)
-            if (!rows.cap[i] && y.b[i] < (std::isnan(held[i]) ? raised : std::min(held[i], raised)))
-              ok = false;
-        }
-      }
-      if (ok) {
-        gained = moved = true;
-        continue;
-      }
-      for (std::size_t s = 0; s < patch.size(); ++s) mesh.points[patch[s]] = x[s];
+  // One model's moves (up to options.models, each rebuilt where the last gained); `unless_plain`:
+  // none where its first model is the plain one's (whose moves the caller saw gain nothing).
+  const auto attempt = [&](bool guarded, bool unless_plain) {
+    // The hexes' own frames below this rise; one at the patch's minimum too (were it held at
+    // the floor, the LP would raise the hex's ratio terms instead).
+    const double rise = guarded ? std::max(sj_floor, options.sj_floor) : sj_floor;
+    // The other hexes near the ratio floor hold their largest coefficients down (caps), where
+    // the floor is not the targets' own ratio (then their ratio terms rise, the others' with
+    // them): the caps are the stricter the more a hex's smallest may fall, and blocked the
+    // bone's joint moves (tests/data/bone_cluster.txt) when they held every hex within twice
+    // the floor.
+    std::vector<std::uint8_t> caps(hexes.size());
+    bool capped = false;
+    for (std::size_t i = 0; i < hexes.size(); ++i) {
+      caps[i] = guarded && !mine[i] && ratios[i] < 1.25 * ratio_floor && ratio_floor < mine_ratio * (1 - 1e-6);
+      capped = capped || caps[i];
     }
-    if (!gained) break;
-    scale = std::min(4 * scale, options.step);  // the box that worked, doubled (the loop halved it once more)
+    bool moved = false;
+    double scale = options.step;
+    for (int model = 0; model < options.models; ++model) {
+      layout_at(mesh, inc, surface, L);
+      if (L.n == 0) break;
+      const Rows rows = patch_rows(mesh, hexes, norms, mine, caps, L);
+      const double now = lowest(rows, rows, rise);
+      if (!(now < options.target)) break;
+      const std::vector<double> held = hold_levels(rows, ratios, now, sj_floor, rise, ratio_floor, guarded);
+      // Without caps, with the same rising frames and every row held at the same level, the
+      // LPs, steps and checks are the plain model's: the same failure (the demo's patches:
+      // half of the joint moves' LP pivots were such repeats).
+      if (model == 0 && unless_plain && !capped && rise == sj_floor &&
+          std::equal(held.begin(), held.end(), hold_levels(rows, ratios, now, sj_floor, sj_floor, ratio_floor, false).begin(),
+                     [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); }))
+        break;
+      bool gained = false;
+      for (int trial = 0; trial < options.trials && !gained; ++trial, scale *= 0.5) {
+        std::vector<double> box(static_cast<std::size_t>(L.n));
+        for (std::size_t s = 0; s < patch.size(); ++s)
+          for (int i = 0; i < L.dims[s]; ++i) box[static_cast<std::size_t>(L.off[s] + i)] = scale * L.len[s];
+        std::vector<double> a, b, w;
+        lp_rows(rows, held, box, options.target, a, b, w);
+        const MaxMinN r = max_min_affine(L.n, a, b, w, box);
+        if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model
+        const std::vector<Vec3> x = [&] {
+          std::vector<Vec3> y;
+          for (Index v : patch) y.push_back(mesh.points[v]);
+          return y;
+        }();
+        bool placed = true;
+        for (std::size_t s = 0; s < patch.size() && placed; ++s) {
+          Vec3 y = x[s];
+          for (int i = 0; i < L.dims[s]; ++i) y += r.d[static_cast<std::size_t>(L.off[s] + i)] * L.basis[s][i];
+          if (surface && L.dims[s] > 0 && !surface->put_back(patch[s], y, L.normal[s], L.len[s])) placed = false;
+          mesh.points[patch[s]] = y;
+        }
+        bool ok = false;
+        if (placed) {
+          const Around after = measure(mesh, hexes, L, &sj0, &start, options.min_edge_shrink);
+          ok = after.valid && after.below <= before.below && after.min_sj >= sj_floor && after.min_ratio >= ratio_floor &&
+               after.max_edges <= edge_cap;
+          if (ok) {
+            // The hex's terms rise, and no other term falls below its level or below them (the
+            // caps are the ratio bound's, checked above on the true values).
+            const Rows y = patch_rows(mesh, hexes, norms, mine, caps, L);
+            ok = y.b.size() == rows.b.size();
+            const double raised = ok ? lowest(rows, y, rise) : now;
+            ok = ok && raised > now + 1e-9;
+            for (std::size_t i = 0; ok && i < y.b.size(); ++i)
+              if (!rows.cap[i] && y.b[i] < (std::isnan(held[i]) ? raised : std::min(held[i], raised)))
+                ok = false;
+          }
+        }
+        if (ok) {
+          gained = moved = true;
+          continue;
+        }
+        for (std::size_t s = 0; s < patch.size(); ++s) mesh.points[patch[s]] = x[s];
+      }
+      if (!gained) break;
+      scale = std::min(4 * scale, options.step);  // the box that worked, doubled (the loop halved it once more)
+    }
+    return moved;  // a step not taken was undone: without a gain the patch is where it was
+  };
+  switch (models) {
+    case PatchModels::plain: return attempt(false, false);
+    case PatchModels::guarded: return attempt(true, false);
+    case PatchModels::both: return attempt(false, false) || attempt(true, true);
   }
-  return moved;  // a step not taken was undone: without a gain the patch is where it was
+  return false;
 }
 
 }  // namespace isohex::opt

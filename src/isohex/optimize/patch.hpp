@@ -30,13 +30,19 @@ namespace isohex::opt {
 /// than min_edge_shrink of its length in `start`). Sliding vertices step in their tangent plane
 /// and are put back on their surface, loose ones into their band. True if the patch moved.
 ///
-/// `guarded`: the LP also keeps the guards' ratio floor (the ratio terms at or above it held
-/// there, and near it the other hexes' largest coefficients held down, since the bound is
-/// min / max), and the hexes' own frames below options.sj_floor rise even where one is the
+/// The guarded model: the LP also keeps the guards' ratio floor (the ratio terms at or above
+/// it held there, and near it the other hexes' largest coefficients held down, since the bound
+/// is min / max), and the hexes' own frames below options.sj_floor rise even where one is the
 /// patch's minimum. Stricter, so tried where the plain model's steps are refused: ECR block_in
 /// with its boundary fixed, every ratio pressed to the 0.2 floor, where the plain LP's every
 /// step lowered a ratio below it.
+///
+/// `both` (the worst pass's): the plain model, and where it gains nothing the guarded one,
+/// unless that is the same LP (no caps, the same frames rising, every row held at the same
+/// level), which would take the same steps and fail the same way.
+enum class PatchModels { plain, guarded, both };
 bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& targets, const std::vector<Index>& patch,
-                const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min, bool guarded = false);
+                const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min,
+                PatchModels models = PatchModels::plain);
 
 }  // namespace isohex::opt

@@ -388,8 +388,7 @@ WorstResult improve_worst(HexMesh& mesh, const std::vector<std::uint8_t>& fixed,
       // tries end at the first that succeeds (so no scan of every hex per try).
       const auto move = [&](const std::vector<Index>& targets, const std::vector<Index>& patch) {
         if (patch.empty() || patch.size() > options.patch_size ||
-            !(opt::move_patch(mesh, inc, targets, patch, start, options, min_before) ||
-              opt::move_patch(mesh, inc, targets, patch, start, options, min_before, true)))
+            !opt::move_patch(mesh, inc, targets, patch, start, options, min_before, opt::PatchModels::both))
           return false;
         for (Index v : patch) {
           unsettle_around(v);
