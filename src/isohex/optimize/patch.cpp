@@ -133,12 +133,14 @@ void hex_rows(const HexMesh& mesh, Index h, int index, const Layout& L, double n
 }
 
 // `mine`: the hexes the move is for; `caps`: those whose coefficients get cap rows (per hex).
-Rows patch_rows(const HexMesh& mesh, const std::vector<Index>& hexes, const std::vector<double>& norms,
-                const std::vector<std::uint8_t>& mine, const std::vector<std::uint8_t>& caps, const Layout& L) {
-  Rows r;
+// Into `r`, emptied first (its storage kept: a large patch's rows are megabytes, and growing
+// them afresh per model and per trial was a tenth of the demo's joint moves in page faults and
+// copies).
+void patch_rows(const HexMesh& mesh, const std::vector<Index>& hexes, const std::vector<double>& norms,
+                const std::vector<std::uint8_t>& mine, const std::vector<std::uint8_t>& caps, const Layout& L, Rows& r) {
+  r.a.clear(), r.b.clear(), r.mine.clear(), r.frame.clear(), r.cap.clear(), r.hex.clear();
   for (std::size_t i = 0; i < hexes.size(); ++i)
     hex_rows(mesh, hexes[i], static_cast<int>(i), L, norms[i], mine[i] != 0, caps[i] != 0, r);
-  return r;
 }
 
 // What the LP does with each row: NaN where the row rises with the bound s, else the level it
@@ -287,7 +289,8 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
     for (int model = 0; model < options.models; ++model) {
       layout_at(mesh, inc, surface, L);
       if (L.n == 0) break;
-      const Rows rows = patch_rows(mesh, hexes, norms, mine, caps, L);
+      thread_local Rows rows, y;  // the model's rows; the true values after a step
+      patch_rows(mesh, hexes, norms, mine, caps, L, rows);
       const double now = lowest(rows, rows, rise);
       if (!(now < options.target)) break;
       const std::vector<double> held = hold_levels(rows, ratios, now, sj_floor, rise, ratio_floor, guarded);
@@ -303,7 +306,8 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
         std::vector<double> box(static_cast<std::size_t>(L.n));
         for (std::size_t s = 0; s < patch.size(); ++s)
           for (int i = 0; i < L.dims[s]; ++i) box[static_cast<std::size_t>(L.off[s] + i)] = scale * L.len[s];
-        std::vector<double> a, b, w;
+        thread_local std::vector<double> a, b, w;  // as the rows' storage
+        a.clear(), b.clear(), w.clear();
         lp_rows(rows, held, box, options.target, a, b, w);
         const MaxMinN r = max_min_affine(L.n, a, b, w, box);
         if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model
@@ -327,7 +331,7 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
           if (ok) {
             // The hex's terms rise, and no other term falls below its level or below them (the
             // caps are the ratio bound's, checked above on the true values).
-            const Rows y = patch_rows(mesh, hexes, norms, mine, caps, L);
+            patch_rows(mesh, hexes, norms, mine, caps, L, y);
             ok = y.b.size() == rows.b.size();
             const double raised = ok ? lowest(rows, y, rise) : now;
             ok = ok && raised > now + 1e-9;
