@@ -240,65 +240,119 @@ void lp_rows(const Rows& rows, const std::vector<double>& held, const std::vecto
   w.push_back(1.0);
 }
 
+// What a joint move reads of the patch as it began: its hexes, their norms, scaled Jacobians
+// and ratio bounds, the move's own hexes, and the guards of move_vertex() over them.
+struct PatchStart {
+  std::vector<Index> hexes;
+  std::vector<double> norms, sj0, ratios;
+  std::vector<std::uint8_t> mine;
+  Around before;
+  double edge_cap = 0, ratio_floor = 0, sj_floor = 0, mine_ratio = 1;
+};
+
+PatchStart patch_start(const HexMesh& mesh, const Incidence& inc, const std::vector<Index>& targets, const Layout& L,
+                       const WorstOptions& options, double mesh_min) {
+  PatchStart ps;
+  for (Index v : L.verts)
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) ps.hexes.push_back(inc.ids[k]);
+  std::sort(ps.hexes.begin(), ps.hexes.end());
+  ps.hexes.erase(std::unique(ps.hexes.begin(), ps.hexes.end()), ps.hexes.end());
+  for (Index h : ps.hexes) ps.norms.push_back(bernstein_norm(mesh.corners(h)));
+  ps.before = measure(mesh, ps.hexes, L, nullptr, nullptr, 0, &ps.sj0, &ps.ratios);
+  ps.edge_cap = std::max(ps.before.max_edges, ps.before.min_ratio < kPoorJacobianRatio ? options.poor_ratio_edge_limit
+                                                                                       : options.max_edge_ratio);
+  ps.ratio_floor = std::min(ps.before.min_ratio, options.ratio_floor);
+  ps.sj_floor = std::min(ps.before.min_sj, std::max(options.sj_floor, mesh_min));
+  ps.mine.resize(ps.hexes.size());
+  for (std::size_t i = 0; i < ps.hexes.size(); ++i) {
+    ps.mine[i] = std::binary_search(targets.begin(), targets.end(), ps.hexes[i]);
+    if (ps.mine[i]) ps.mine_ratio = std::min(ps.mine_ratio, ps.ratios[i]);
+  }
+  return ps;
+}
+
+// The patch moved by the LP's step `d` (sliding vertices put back on their surface) and judged
+// on the true values: kept if no guard fails, the hex's terms that rise (`rows`, chosen with
+// `rise`) rise above `now`, and no other term falls below its level (`held`) or below them.
+// Otherwise every vertex goes back where it was. True if kept.
+bool take_step(HexMesh& mesh, const PatchStart& ps, const Layout& L, const std::vector<double>& d, const Rows& rows,
+               const std::vector<double>& held, const std::vector<std::uint8_t>& caps, double now, double rise,
+               const std::vector<Vec3>& start, const WorstOptions& options) {
+  const BoundarySurface* surface = options.surface;
+  const std::vector<Index>& patch = L.verts;
+  thread_local std::vector<Vec3> x;
+  x.clear();
+  for (Index v : patch) x.push_back(mesh.points[v]);
+  bool placed = true;
+  for (std::size_t s = 0; s < patch.size() && placed; ++s) {
+    Vec3 y = x[s];
+    for (int i = 0; i < L.dims[s]; ++i) y += d[static_cast<std::size_t>(L.off[s] + i)] * L.basis[s][i];
+    if (surface && L.dims[s] > 0 && !surface->put_back(patch[s], y, L.normal[s], L.len[s])) placed = false;
+    mesh.points[patch[s]] = y;
+  }
+  bool ok = false;
+  if (placed) {
+    const Around after = measure(mesh, ps.hexes, L, &ps.sj0, &start, options.min_edge_shrink);
+    ok = after.valid && after.below <= ps.before.below && after.min_sj >= ps.sj_floor &&
+         after.min_ratio >= ps.ratio_floor && after.max_edges <= ps.edge_cap;
+    if (ok) {
+      // The caps are the ratio bound's, checked above on the true values.
+      thread_local Rows y;
+      patch_rows(mesh, ps.hexes, ps.norms, ps.mine, caps, L, y);
+      ok = y.b.size() == rows.b.size();
+      const double raised = ok ? lowest(rows, y, rise) : now;
+      ok = ok && raised > now + 1e-9;
+      for (std::size_t i = 0; ok && i < y.b.size(); ++i)
+        if (!rows.cap[i] && y.b[i] < (std::isnan(held[i]) ? raised : std::min(held[i], raised))) ok = false;
+    }
+  }
+  if (!ok)
+    for (std::size_t s = 0; s < patch.size(); ++s) mesh.points[patch[s]] = x[s];
+  return ok;
+}
+
 }  // namespace
 
 bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& targets, const std::vector<Index>& patch,
                 const std::vector<Vec3>& start, const WorstOptions& options, double mesh_min, PatchModels models) {
   if (patch.empty()) return false;
-  const BoundarySurface* surface = options.surface;
-  std::vector<Index> hexes;
-  for (Index v : patch)
-    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) hexes.push_back(inc.ids[k]);
-  std::sort(hexes.begin(), hexes.end());
-  hexes.erase(std::unique(hexes.begin(), hexes.end()), hexes.end());
-  std::vector<double> norms, sj0, ratios;
-  for (Index h : hexes) norms.push_back(bernstein_norm(mesh.corners(h)));
   Layout L;
   L.verts = patch;
-  const Around before = measure(mesh, hexes, L, nullptr, nullptr, 0, &sj0, &ratios);
-  // The guards of move_vertex(), over the patch's hexes.
-  const double edge_cap = std::max(before.max_edges, before.min_ratio < kPoorJacobianRatio ? options.poor_ratio_edge_limit
-                                                                                           : options.max_edge_ratio);
-  const double ratio_floor = std::min(before.min_ratio, options.ratio_floor);
-  const double sj_floor = std::min(before.min_sj, std::max(options.sj_floor, mesh_min));
-  std::vector<std::uint8_t> mine(hexes.size());
-  double mine_ratio = 1;
-  for (std::size_t i = 0; i < hexes.size(); ++i) {
-    mine[i] = std::binary_search(targets.begin(), targets.end(), hexes[i]);
-    if (mine[i]) mine_ratio = std::min(mine_ratio, ratios[i]);
-  }
+  const PatchStart ps = patch_start(mesh, inc, targets, L, options, mesh_min);
   // One model's moves (up to options.models, each rebuilt where the last gained); `unless_plain`:
   // none where its first model is the plain one's (whose moves the caller saw gain nothing).
   const auto attempt = [&](bool guarded, bool unless_plain) {
     // The hexes' own frames below this rise; one at the patch's minimum too (were it held at
     // the floor, the LP would raise the hex's ratio terms instead).
-    const double rise = guarded ? std::max(sj_floor, options.sj_floor) : sj_floor;
+    const double rise = guarded ? std::max(ps.sj_floor, options.sj_floor) : ps.sj_floor;
     // The other hexes near the ratio floor hold their largest coefficients down (caps), where
     // the floor is not the targets' own ratio (then their ratio terms rise, the others' with
     // them): the caps are the stricter the more a hex's smallest may fall, and blocked the
     // bone's joint moves (tests/data/bone_cluster.txt) when they held every hex within twice
     // the floor.
-    std::vector<std::uint8_t> caps(hexes.size());
+    std::vector<std::uint8_t> caps(ps.hexes.size());
     bool capped = false;
-    for (std::size_t i = 0; i < hexes.size(); ++i) {
-      caps[i] = guarded && !mine[i] && ratios[i] < 1.25 * ratio_floor && ratio_floor < mine_ratio * (1 - 1e-6);
+    for (std::size_t i = 0; i < ps.hexes.size(); ++i) {
+      caps[i] = guarded && !ps.mine[i] && ps.ratios[i] < 1.25 * ps.ratio_floor &&
+                ps.ratio_floor < ps.mine_ratio * (1 - 1e-6);
       capped = capped || caps[i];
     }
     bool moved = false;
     double scale = options.step;
     for (int model = 0; model < options.models; ++model) {
-      layout_at(mesh, inc, surface, L);
+      layout_at(mesh, inc, options.surface, L);
       if (L.n == 0) break;
-      thread_local Rows rows, y;  // the model's rows; the true values after a step
-      patch_rows(mesh, hexes, norms, mine, caps, L, rows);
+      thread_local Rows rows;
+      patch_rows(mesh, ps.hexes, ps.norms, ps.mine, caps, L, rows);
       const double now = lowest(rows, rows, rise);
       if (!(now < options.target)) break;
-      const std::vector<double> held = hold_levels(rows, ratios, now, sj_floor, rise, ratio_floor, guarded);
+      const std::vector<double> held = hold_levels(rows, ps.ratios, now, ps.sj_floor, rise, ps.ratio_floor, guarded);
       // Without caps, with the same rising frames and every row held at the same level, the
       // LPs, steps and checks are the plain model's: the same failure (the demo's patches:
       // half of the joint moves' LP pivots were such repeats).
-      if (model == 0 && unless_plain && !capped && rise == sj_floor &&
-          std::equal(held.begin(), held.end(), hold_levels(rows, ratios, now, sj_floor, sj_floor, ratio_floor, false).begin(),
+      if (model == 0 && unless_plain && !capped && rise == ps.sj_floor &&
+          std::equal(held.begin(), held.end(),
+                     hold_levels(rows, ps.ratios, now, ps.sj_floor, ps.sj_floor, ps.ratio_floor, false).begin(),
                      [](double x, double y) { return x == y || (std::isnan(x) && std::isnan(y)); }))
         break;
       bool gained = false;
@@ -311,42 +365,10 @@ bool move_patch(HexMesh& mesh, const Incidence& inc, const std::vector<Index>& t
         lp_rows(rows, held, box, options.target, a, b, w);
         const MaxMinN r = max_min_affine(L.n, a, b, w, box);
         if (!r.ok || !(r.s > now + 1e-9)) break;  // no ascent even in the model
-        const std::vector<Vec3> x = [&] {
-          std::vector<Vec3> y;
-          for (Index v : patch) y.push_back(mesh.points[v]);
-          return y;
-        }();
-        bool placed = true;
-        for (std::size_t s = 0; s < patch.size() && placed; ++s) {
-          Vec3 y = x[s];
-          for (int i = 0; i < L.dims[s]; ++i) y += r.d[static_cast<std::size_t>(L.off[s] + i)] * L.basis[s][i];
-          if (surface && L.dims[s] > 0 && !surface->put_back(patch[s], y, L.normal[s], L.len[s])) placed = false;
-          mesh.points[patch[s]] = y;
-        }
-        bool ok = false;
-        if (placed) {
-          const Around after = measure(mesh, hexes, L, &sj0, &start, options.min_edge_shrink);
-          ok = after.valid && after.below <= before.below && after.min_sj >= sj_floor && after.min_ratio >= ratio_floor &&
-               after.max_edges <= edge_cap;
-          if (ok) {
-            // The hex's terms rise, and no other term falls below its level or below them (the
-            // caps are the ratio bound's, checked above on the true values).
-            patch_rows(mesh, hexes, norms, mine, caps, L, y);
-            ok = y.b.size() == rows.b.size();
-            const double raised = ok ? lowest(rows, y, rise) : now;
-            ok = ok && raised > now + 1e-9;
-            for (std::size_t i = 0; ok && i < y.b.size(); ++i)
-              if (!rows.cap[i] && y.b[i] < (std::isnan(held[i]) ? raised : std::min(held[i], raised)))
-                ok = false;
-          }
-        }
-        if (ok) {
-          gained = moved = true;
-          continue;
-        }
-        for (std::size_t s = 0; s < patch.size(); ++s) mesh.points[patch[s]] = x[s];
+        gained = take_step(mesh, ps, L, r.d, rows, held, caps, now, rise, start, options);
       }
       if (!gained) break;
+      moved = true;
       scale = std::min(4 * scale, options.step);  // the box that worked, doubled (the loop halved it once more)
     }
     return moved;  // a step not taken was undone: without a gain the patch is where it was
