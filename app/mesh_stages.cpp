@@ -14,6 +14,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <sys/resource.h>
@@ -88,6 +89,43 @@ ProgressCallback progress_printer(std::FILE* out) {
   };
 }
 
+namespace {
+
+// The worst pass's printed lines and JSON facts.
+nlohmann::json report_worst(const WorstResult& w, double seconds) {
+  fmt::print("worst: {} passes, {} moves{}{}, min SJ {:.4f} -> {:.4f}\n", w.passes, w.moves,
+             w.patch_moves ? fmt::format(" and {} joint moves of patches", w.patch_moves) : "",
+             w.searched ? fmt::format("; random search raised {} of {} clusters", w.search_gains, w.searched) : "",
+             w.min_sj_before, w.min_sj_after);
+  nlohmann::json j = {{"passes", w.passes},
+                      {"moves", w.moves},
+                      {"patch_moves", w.patch_moves},
+                      {"patch_skipped", w.patch_skipped},
+                      {"searched", w.searched},
+                      {"search_gains", w.search_gains},
+                      {"min_sj_before", w.min_sj_before},
+                      {"min_sj_after", w.min_sj_after},
+                      {"seconds", seconds},
+                      {"passes_seconds", w.passes_seconds},
+                      {"patch_seconds", w.patch_seconds},
+                      {"search_seconds", w.search_seconds}};
+  // The hexes no placement of the free vertices lifts to 0.2, proven (find_quality_bounds()).
+  auto& proven = j["proven"] = nlohmann::json::array();
+  for (const QualityBound& b : w.proven)
+    proven.push_back({{"kind", to_string(b.kind)}, {"vertex", b.vertex}, {"free", b.free}, {"bound", b.bound},
+                      {"hexes", b.hexes}});
+  for (std::size_t i = 0; i < w.proven.size() && i < 5; ++i) {
+    const QualityBound& b = w.proven[i];
+    fmt::print("  proven with the fixed vertices: one of hexes {} stays at or below {:.4f} ({} at vertex {}{})\n",
+               fmt::join(b.hexes, ","), b.bound, to_string(b.kind), b.vertex,
+               b.free >= 0 ? fmt::format(", free edge to {}", b.free) : "");
+  }
+  if (w.proven.size() > 5) fmt::print("  ... and {} more proofs (JSON: worst.proven)\n", w.proven.size() - 5);
+  return j;
+}
+
+}  // namespace
+
 nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options) {
   const OptimizeResult r = optimize_mesh(mesh, fixed, options);
   nlohmann::json j = nlohmann::json::object();
@@ -128,37 +166,7 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
              s.objective_after, s.frozen_hexes ? fmt::format(" ({} invalid hexes held)", s.frozen_hexes) : "");
   j["shape"] = {{"iterations", s.iterations}, {"objective_before", s.objective_before},
                 {"objective_after", s.objective_after}, {"frozen_hexes", s.frozen_hexes}, {"seconds", r.shape_seconds}};
-  if (r.worst_run) {
-    const WorstResult& w = r.worst;
-    fmt::print("worst: {} passes, {} moves{}{}, min SJ {:.4f} -> {:.4f}\n", w.passes, w.moves,
-               w.patch_moves ? fmt::format(" and {} joint moves of patches", w.patch_moves) : "",
-               w.searched ? fmt::format("; random search raised {} of {} clusters", w.search_gains, w.searched) : "",
-               w.min_sj_before, w.min_sj_after);
-    j["worst"] = {{"passes", w.passes},
-                  {"moves", w.moves},
-                  {"patch_moves", w.patch_moves},
-                  {"patch_skipped", w.patch_skipped},
-                  {"searched", w.searched},
-                  {"search_gains", w.search_gains},
-                  {"min_sj_before", w.min_sj_before},
-                  {"min_sj_after", w.min_sj_after},
-                  {"seconds", r.worst_seconds},
-                  {"passes_seconds", w.passes_seconds},
-                  {"patch_seconds", w.patch_seconds},
-                  {"search_seconds", w.search_seconds}};
-    // The hexes no placement of the free vertices lifts to 0.2, proven (find_quality_bounds()).
-    auto& proven = j["worst"]["proven"] = nlohmann::json::array();
-    for (const QualityBound& b : w.proven)
-      proven.push_back({{"kind", to_string(b.kind)}, {"vertex", b.vertex}, {"free", b.free}, {"bound", b.bound},
-                        {"hexes", b.hexes}});
-    for (std::size_t i = 0; i < w.proven.size() && i < 5; ++i) {
-      const QualityBound& b = w.proven[i];
-      fmt::print("  proven with the fixed vertices: one of hexes {} stays at or below {:.4f} ({} at vertex {}{})\n",
-                 fmt::join(b.hexes, ","), b.bound, to_string(b.kind), b.vertex,
-                 b.free >= 0 ? fmt::format(", free edge to {}", b.free) : "");
-    }
-    if (w.proven.size() > 5) fmt::print("  ... and {} more proofs (JSON: worst.proven)\n", w.proven.size() - 5);
-  }
+  if (r.worst_run) j["worst"] = report_worst(r.worst, r.worst_seconds);
   return j;
 }
 
@@ -341,7 +349,7 @@ nlohmann::json rounds_in_band(HexMesh& mesh, BoundarySurface& surface, double ba
 }  // namespace
 
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& o,
-                              std::size_t* reattached) {
+                              std::size_t* reattached, bool* poor_left) {
   const Incidence inc = vertex_hexes(mesh);
   const BoundarySurface::Roles start = surface.roles();
   RoundJournal journal(mesh.points.size());
@@ -384,6 +392,8 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& b
     fmt::print("boundary: {} of the {} released vertices back on their surface\n", back.reattached, back.loose_before);
     if (reattached) *reattached = back.reattached;
   }
+  // (Putting vertices back takes no hex below 0.2 nor a ratio below 0.1: the score stands.)
+  if (poor_left) *poor_left = score.below + score.poor > 0;
   return released;
 }
 
@@ -441,21 +451,16 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
   nlohmann::json j = run_optimisation(mesh, fixed, first);
   std::size_t reattached = 0;
   double band = slide.band;  // wider if the rounds ran again (release_rounds())
+  bool poor_left = false;
   const nlohmann::json released =
-      rounds_follow ? release_rounds(mesh, *surface, band, o, &reattached) : nlohmann::json::array();
-  if (rounds_follow && released.empty()) {
+      rounds_follow ? release_rounds(mesh, *surface, band, o, &reattached, &poor_left) : nlohmann::json::array();
+  if (rounds_follow && released.empty() && poor_left) {
     // No round ran (no hex below 0.2 by rank has a boundary vertex to release within reach):
-    // the end game the first run left to them, here.
-    RoundScore score;
-    round_ranks(mesh, score);
-    if (score.below + score.poor > 0) {
-      OptimizeOptions end = o;
-      end.untangle = false;
-      end.shape_options.max_iter = 0;
-      fmt::print("worst: {} hexes below 0.2, {} with a jacobian ratio below 0.1, no boundary vertex of theirs to "
-                 "release: the end game with the boundary held\n", score.below, score.poor);
-      j["end_game"] = run_optimisation(mesh, fixed, end);
-    }
+    // the end game the first run left to them, here, the boundary on its surfaces.
+    fmt::print("worst: hexes below 0.2 and none of their boundary vertices to release: the end game\n");
+    const auto t0 = std::chrono::steady_clock::now();
+    const WorstResult w = improve_worst(mesh, fixed, o.worst_options);
+    j["end_game"] = report_worst(w, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   if (surface) {
     const auto [far, off] = surface->fit(mesh);

@@ -59,9 +59,10 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 /// Ends by putting released vertices back on their surface where the hexes allow it
 /// (reattach_released()); how many, into `reattached` (may be null). Rounds that leave hexes
 /// invalid run once more from their start in a band 5/3 as wide, and the better run is kept
-/// (`band` then holds the wider band).
+/// (`band` then holds the wider band). `poor_left` (may be null): whether hexes are still below
+/// 0.2 or have a jacobian ratio below 0.1 after the rounds (or before them, where none ran).
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& options,
-                              std::size_t* reattached = nullptr);
+                              std::size_t* reattached = nullptr, bool* poor_left = nullptr);
 
 /// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
 /// (`--boundary slide`): each boundary vertex on its own surface, the one `vertex_place` names

@@ -105,13 +105,14 @@ constexpr int kInteriorBlocks = (kAllFrames - kFrames + 3) / 4;
 // (Built on first use: frame_coefficient()'s table is another file's static.)
 const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
   static const std::array<double, kInteriorBlocks * 8 * 3 * 4> table = [] {
-  std::array<double, kInteriorBlocks * 8 * 3 * 4> c{};
-  for (int t = kFrames; t < kAllFrames; ++t) {
-    const int b = (t - kFrames) / 4, lane = (t - kFrames) % 4;
-    for (int k = 0; k < 8; ++k)
-      for (int j = 0; j < 3; ++j) c[static_cast<std::size_t>(((b * 8 + k) * 3 + j) * 4 + lane)] = frame_coefficient(t, k)[j];
-  }
-  return c;
+    std::array<double, kInteriorBlocks * 8 * 3 * 4> c{};
+    for (int t = kFrames; t < kAllFrames; ++t) {
+      const int b = (t - kFrames) / 4, lane = (t - kFrames) % 4;
+      for (int k = 0; k < 8; ++k)
+        for (int j = 0; j < 3; ++j)
+          c[static_cast<std::size_t>(((b * 8 + k) * 3 + j) * 4 + lane)] = frame_coefficient(t, k)[j];
+    }
+    return c;
   }();
   return table;
 }
@@ -139,8 +140,8 @@ const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
   }
 }
 
-// Determinants and det_gradient()s of up to 28 frames, four at a time, in the orders of Eigen's determinant() and of det_gradient()'s
-// expression: the same bits.
+// Determinants and det_gradient()s of up to 28 frames, four at a time, in the orders of
+// Eigen's determinant() and of det_gradient()'s expression: the same bits.
 [[gnu::always_inline]] inline void lattice_body(LatticeFrames& f, bool gradients) {
   for (int b = 0; b < LatticeFrames::kBlocks; ++b) {
     const d4 a0 = lanes(b, f.a[0]), a1 = lanes(b, f.a[1]), a2 = lanes(b, f.a[2]), a3 = lanes(b, f.a[3]),
