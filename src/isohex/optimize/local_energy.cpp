@@ -293,7 +293,11 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     int k = 0;
     while (mesh.hexes[h][k] != v) ++k;
     p[k] = x;
-    HexFrames hf{h, k, inv_len[h], params.eps_of(h), batch.size, 0, params.bernstein_of(h)};
+    // Filled in place: a HexFrames built on the stack and copied in stalled the loads of the
+    // copy on the stores just made (5-10 % of this function's time on ECR block_in).
+    HexFrames& hf = hexes.emplace_back();
+    hf.h = h, hf.k = k, hf.il = inv_len[h], hf.eps = params.eps_of(h), hf.first = batch.size;
+    hf.bernstein = params.bernstein_of(h);
     const int frames = params.frames_of(h);
     InteriorFrames interior;  // the hex's 26 interior frames, at once
     if (frames > kFrames) interior_frames(relative_corners(p), hf.il, interior);
@@ -314,7 +318,6 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
       batch.at(j, FrameBatch::kConstraint) = !params.untangle && t >= kCentreFrame;
     }
     hf.last = batch.size;
-    hexes.push_back(hf);
     bernstein = bernstein || hf.bernstein;
   }
   batch.compute(params.untangle, params.lambda);

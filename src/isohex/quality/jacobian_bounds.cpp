@@ -9,8 +9,15 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <queue>
 #include <tuple>
 
@@ -18,10 +25,56 @@ namespace isohex {
 
 namespace {
 
+// x − x is 0 for a finite x and NaN otherwise: one pass over the 24 coordinates (every
+// certificate starts here).
 bool all_finite(const std::array<Vec3, 8>& p) {
-  for (const Vec3& x : p)
-    if (!x.allFinite()) return false;
-  return true;
+  static_assert(sizeof(p) == 24 * sizeof(double), "8 packed Vec3s");
+  const double* x = p[0].data();
+#if defined(__SSE2__)
+  __m128d acc = _mm_setzero_pd();
+  for (int i = 0; i < 24; i += 2) {
+    const __m128d v = _mm_loadu_pd(x + i);
+    acc = _mm_add_pd(acc, _mm_sub_pd(v, v));
+  }
+  double a[2];
+  _mm_storeu_pd(a, acc);
+  return a[0] + a[1] == 0;
+#else
+  double acc = 0;
+  for (int i = 0; i < 24; ++i) acc += x[i] - x[i];
+  return acc == 0;
+#endif
+}
+
+// The smallest and largest Bernstein coefficient and the smallest sample of a box, in one pass
+// (two lanes at a time: every certificate reads them). A non-finite value anywhere (an
+// overflow) makes min_s NaN: never certified.
+struct Extremes {
+  double min_b, max_b, min_s;
+};
+Extremes extremes(const std::array<double, 27>& b, const std::array<double, 27>& s) {
+  Extremes e{b[26], b[26], s[26]};
+  double sum = b[26] + s[26];
+#if defined(__SSE2__)
+  __m128d lo = _mm_set1_pd(b[26]), hi = lo, ls = _mm_set1_pd(s[26]), acc = _mm_setzero_pd();
+  for (int i = 0; i < 26; i += 2) {
+    const __m128d x = _mm_loadu_pd(b.data() + i), y = _mm_loadu_pd(s.data() + i);
+    lo = _mm_min_pd(x, lo), hi = _mm_max_pd(x, hi), ls = _mm_min_pd(y, ls);
+    acc = _mm_add_pd(acc, _mm_add_pd(x, y));
+  }
+  double l[2], h[2], m[2], a[2];
+  _mm_storeu_pd(l, lo), _mm_storeu_pd(h, hi), _mm_storeu_pd(m, ls), _mm_storeu_pd(a, acc);
+  e = {std::min(l[0], l[1]), std::max(h[0], h[1]), std::min(m[0], m[1])};
+  sum += a[0] + a[1];
+#else
+  for (int i = 0; i < 26; ++i) {
+    e.min_b = std::min(e.min_b, b[i]), e.max_b = std::max(e.max_b, b[i]), e.min_s = std::min(e.min_s, s[i]);
+    sum += b[i] + s[i];
+  }
+#endif
+  if (!std::isfinite(sum)) e.min_s = std::numeric_limits<double>::quiet_NaN();
+  if (e.min_b == 0) e.min_b = 0.0;  // +0 whichever zero came first: ratio_bound()'s sign
+  return e;
 }
 
 // Corners relative to corner 0: det J is translation invariant, and differences keep the
@@ -51,37 +104,26 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
   return edge_u(p, v, w).dot(edge_v(p, u, w).cross(edge_w(p, u, v)));
 }
 
-// A bilinear blend of the edge vectors a (at parameters 0, 0), b (1, 0), c (0, 1) and d (1, 1)
-// at the 3×3 lattice of 0, 1/2, 1 (x[i + 3j] at (i/2, j/2)), but for the centre x[4], whose sum
-// the caller orders as edge_u() and the others do.
-void unit_lattice(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, std::array<Vec3, 9>& x) {
-  x[0] = a, x[2] = b, x[6] = c, x[8] = d;
-  x[1] = 0.5 * a + 0.5 * b;
-  x[7] = 0.5 * c + 0.5 * d;
-  x[3] = 0.5 * a + 0.5 * c;
-  x[5] = 0.5 * b + 0.5 * d;
+// In place: the lattice values of a triquadratic to its Bernstein coefficients (per axis, the
+// quadratic through the values at 0, 1/2, 1 has Bernstein coefficients f(0),
+// 2 f(1/2) - (f(0) + f(1))/2, f(1)).
+[[gnu::always_inline]] inline void lattice_to_bernstein_body(double* f) {
+  const auto line = [&](int a, int b, int c) { f[b] = 2 * f[b] - 0.5 * (f[a] + f[c]); };
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) line(3 * j + 9 * k, 1 + 3 * j + 9 * k, 2 + 3 * j + 9 * k);
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 3; ++i) line(i + 9 * k, i + 3 + 9 * k, i + 6 + 9 * k);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) line(i + 3 * j, i + 3 * j + 9, i + 3 * j + 18);
 }
 
-// det J at the 27 lattice points, b[i + 3j + 9k] = xu[j + 3k] · (xv[i + 3k] × xw[i + 3j]):
-// the operands laid out side by side first (structure of arrays), so that the compiler packs
-// the 27 triple products into SIMD instructions; each is Eigen's cross then dot, the same
-// operations in the same order, so the same bits (tested). Two and a half times faster than
-// the loop over Vec3s, and the certificates (every shape step's, every worst-pass trial's) are
-// most of their callers' time.
-[[gnu::always_inline]] inline void lattice_dets_body(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv,
-                                                     const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
-  alignas(64) double U[3][28], V[3][28], W[3][28], b[28];
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) {
-        const int n = i + 3 * j + 9 * k;
-        for (int c = 0; c < 3; ++c) {
-          U[c][n] = xu[j + 3 * k][c];
-          V[c][n] = xv[i + 3 * k][c];
-          W[c][n] = xw[i + 3 * j][c];
-        }
-      }
-  for (int c = 0; c < 3; ++c) U[c][27] = V[c][27] = W[c][27] = 0;  // a 28th lane: whole vectors
+// det J at the 27 lattice points, b[i + 3j + 9k] = xu[j + 3k] · (xv[i + 3k] × xw[i + 3j]),
+// from the operands laid out side by side (structure of arrays, U[c][n] the component c of
+// lane n), so that the compiler packs the 27 triple products into SIMD instructions; each is
+// Eigen's cross then dot, the same operations in the same order, so the same bits (tested).
+[[gnu::always_inline]] inline void triple_products(const double (&U)[3][28], const double (&V)[3][28],
+                                                   const double (&W)[3][28], double* out) {
+  alignas(64) double b[28];
   for (int n = 0; n < 28; ++n) {
     const double cx = V[1][n] * W[2][n] - V[2][n] * W[1][n];
     const double cy = V[2][n] * W[0][n] - V[0][n] * W[2][n];
@@ -89,6 +131,68 @@ void unit_lattice(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, st
     b[n] = U[0][n] * cx + U[1][n] * cy + U[2][n] * cz;
   }
   for (int n = 0; n < 27; ++n) out[n] = b[n];
+}
+
+// The lanes of lattice point n = i + 3j + 9k from per-component lattices xu[j + 3k] (at
+// (v_j, w_k)), xv[i + 3k] and xw[i + 3j]; a 28th lane of zeros makes whole vectors.
+[[gnu::always_inline]] inline void spread(int c, const double* xu, const double* xv, const double* xw,
+                                          double (&U)[3][28], double (&V)[3][28], double (&W)[3][28]) {
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        const int n = i + 3 * j + 9 * k;
+        U[c][n] = xu[j + 3 * k];
+        V[c][n] = xv[i + 3 * k];
+        W[c][n] = xw[i + 3 * j];
+      }
+  U[c][27] = V[c][27] = W[c][27] = 0;
+}
+
+// det J at the lattice of a sub-box, from its 9 edge vectors of each direction.
+[[gnu::always_inline]] inline void lattice_dets_body(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv,
+                                                     const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
+  alignas(64) double U[3][28], V[3][28], W[3][28];
+  for (int c = 0; c < 3; ++c) {
+    double u[9], v[9], w[9];
+    for (int m = 0; m < 9; ++m) u[m] = xu[m][c], v[m] = xv[m][c], w[m] = xw[m][c];
+    spread(c, u, v, w, U, V, W);
+  }
+  triple_products(U, V, W, out.data());
+}
+
+// A bilinear blend of one component of the edge vectors a (at parameters 0, 0), b (1, 0),
+// c (0, 1) and d (1, 1) on the 3×3 lattice of 0, 1/2, 1 (x[i + 3j] at (i/2, j/2)); the centre
+// x[4] is the caller's, whose sum it orders as edge_u() and the others do.
+[[gnu::always_inline]] inline void unit_lattice(double a, double b, double c, double d, double* x) {
+  x[0] = a, x[2] = b, x[6] = c, x[8] = d;
+  x[1] = 0.5 * a + 0.5 * b;
+  x[7] = 0.5 * c + 0.5 * d;
+  x[3] = 0.5 * a + 0.5 * c;
+  x[5] = 0.5 * b + 0.5 * d;
+}
+
+// The whole element (most calls): det J at its lattice (`samples`) and its Bernstein
+// coefficients (`coef`). edge_u() and the others at 0, 1/2 and 1 are its edges and their halves
+// and quarters, per component straight into the lanes: the same sums in the same order as
+// det_at(), without the zero terms (tested bit for bit). Every certificate runs this.
+[[gnu::always_inline]] inline void whole_element_body(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  alignas(64) double U[3][28], V[3][28], W[3][28];
+  for (int c = 0; c < 3; ++c) {
+    double u[9], v[9], w[9];
+    const double ua = q[1][c] - q[0][c], ub = q[2][c] - q[3][c], uc = q[5][c] - q[4][c], ud = q[6][c] - q[7][c];
+    const double va = q[3][c] - q[0][c], vb = q[2][c] - q[1][c], vc = q[7][c] - q[4][c], vd = q[6][c] - q[5][c];
+    const double wa = q[4][c] - q[0][c], wb = q[5][c] - q[1][c], wc = q[7][c] - q[3][c], wd = q[6][c] - q[2][c];
+    unit_lattice(ua, ub, uc, ud, u);
+    u[4] = 0.25 * ua + 0.25 * ub + 0.25 * uc + 0.25 * ud;
+    unit_lattice(va, vb, vc, vd, v);
+    v[4] = 0.25 * va + 0.25 * vb + 0.25 * vc + 0.25 * vd;
+    unit_lattice(wa, wb, wc, wd, w);
+    w[4] = 0.25 * wa + 0.25 * wb + 0.25 * wd + 0.25 * wc;
+    spread(c, u, v, w, U, V, W);
+  }
+  triple_products(U, V, W, samples);
+  for (int n = 0; n < 27; ++n) coef[n] = samples[n];
+  lattice_to_bernstein_body(coef);
 }
 
 #if ISOHEX_HAVE_FMV
@@ -102,10 +206,19 @@ void unit_lattice(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, st
                                           const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
   lattice_dets_body(xu, xv, xw, out);
 }
+[[gnu::target("default")]] void whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  whole_element_body(q, samples, coef);
+}
+[[gnu::target("avx2")]] void whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  whole_element_body(q, samples, coef);
+}
 #else
 void lattice_dets(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv, const std::array<Vec3, 9>& xw,
                   std::array<double, 27>& out) {
   lattice_dets_body(xu, xv, xw, out);
+}
+void whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  whole_element_body(q, samples, coef);
 }
 #endif
 
@@ -115,26 +228,20 @@ void lattice_dets(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv, 
 std::array<double, 27> bernstein_box(const std::array<Vec3, 8>& q, const Vec3& lo, const Vec3& hi,
                                      std::array<double, 27>* samples) {
   std::array<double, 27> b;
+  if (lo == Vec3::Zero() && hi == Vec3::Ones()) {
+    std::array<double, 27> s;
+    whole_element(q, samples ? samples->data() : s.data(), b.data());
+    return b;
+  }
   const Vec3 mid = 0.5 * (lo + hi);
   const double us[3] = {lo[0], mid[0], hi[0]}, vs[3] = {lo[1], mid[1], hi[1]}, ws[3] = {lo[2], mid[2], hi[2]};
   std::array<Vec3, 9> xu, xv, xw;  // xu[j + 3k] at (v_j, w_k), xv[i + 3k] at (u_i, w_k), xw[i + 3j] at (u_i, v_j)
-  if (lo == Vec3::Zero() && hi == Vec3::Ones()) {
-    // The whole element (most calls): edge_u() and the others at 0, 1/2 and 1 are its edges
-    // and their halves and quarters; the same sums in the same order without the zero terms.
-    unit_lattice(q[1] - q[0], q[2] - q[3], q[5] - q[4], q[6] - q[7], xu);
-    xu[4] = 0.25 * (q[1] - q[0]) + 0.25 * (q[2] - q[3]) + 0.25 * (q[5] - q[4]) + 0.25 * (q[6] - q[7]);
-    unit_lattice(q[3] - q[0], q[2] - q[1], q[7] - q[4], q[6] - q[5], xv);
-    xv[4] = 0.25 * (q[3] - q[0]) + 0.25 * (q[2] - q[1]) + 0.25 * (q[7] - q[4]) + 0.25 * (q[6] - q[5]);
-    unit_lattice(q[4] - q[0], q[5] - q[1], q[7] - q[3], q[6] - q[2], xw);
-    xw[4] = 0.25 * (q[4] - q[0]) + 0.25 * (q[5] - q[1]) + 0.25 * (q[6] - q[2]) + 0.25 * (q[7] - q[3]);
-  } else {
-    for (int b2 = 0; b2 < 3; ++b2)
-      for (int a = 0; a < 3; ++a) {
-        xu[a + 3 * b2] = edge_u(q, vs[a], ws[b2]);
-        xv[a + 3 * b2] = edge_v(q, us[a], ws[b2]);
-        xw[a + 3 * b2] = edge_w(q, us[a], vs[b2]);
-      }
-  }
+  for (int b2 = 0; b2 < 3; ++b2)
+    for (int a = 0; a < 3; ++a) {
+      xu[a + 3 * b2] = edge_u(q, vs[a], ws[b2]);
+      xv[a + 3 * b2] = edge_v(q, us[a], ws[b2]);
+      xw[a + 3 * b2] = edge_w(q, us[a], vs[b2]);
+    }
   lattice_dets(xu, xv, xw, b);
   if (samples) *samples = b;
   lattice_to_bernstein(b);
@@ -265,32 +372,35 @@ double abs_volume(const std::array<Vec3, 8>& p) {
   return sum / (n * n * n);
 }
 
-// certified_valid() from the element's own coefficients `b` and samples `s` (box [0,1]^3):
-// depth first on the boxes whose coefficients are not all above the floor; any sample at or
-// below it decides "not certified" at once.
-bool certify(const std::array<Vec3, 8>& q, std::array<double, 27> b, std::array<double, 27> s, double floor,
-             int max_subdivisions) {
+// certified_valid() from the element's own extremes `root` (box [0,1]^3): depth first on the
+// boxes whose coefficients are not all above the floor; any sample at or below it decides "not
+// certified" at once.
+bool certify(const std::array<Vec3, 8>& q, const Extremes& root, double floor, int max_subdivisions) {
+  if (!(root.min_s > floor)) return false;
+  if (root.min_b > floor) return true;  // most calls: the element's own coefficients suffice
+  if (max_subdivisions < 1) return false;
   std::vector<std::pair<Vec3, Vec3>> stack;
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Ones();
-  int splits = 0;
-  for (;;) {
-    if (!(*std::min_element(s.begin(), s.end()) > floor)) return false;
-    if (!(*std::min_element(b.begin(), b.end()) > floor)) {
+  for (int c = 0; c < 8; ++c) stack.push_back(child(Vec3::Zero(), Vec3::Ones(), c));
+  int splits = 1;
+  std::array<double, 27> s;
+  while (!stack.empty()) {
+    const auto [lo, hi] = stack.back();
+    stack.pop_back();
+    const std::array<double, 27> b = bernstein_box(q, lo, hi, &s);
+    const Extremes e = extremes(b, s);
+    if (!(e.min_s > floor)) return false;
+    if (!(e.min_b > floor)) {
       if (++splits > max_subdivisions) return false;
       for (int c = 0; c < 8; ++c) stack.push_back(child(lo, hi, c));
     }
-    if (stack.empty()) return true;
-    std::tie(lo, hi) = stack.back();
-    stack.pop_back();
-    b = bernstein_box(q, lo, hi, &s);
   }
+  return true;
 }
 
 // min / max of the element's coefficients (jacobian_ratio_bound()).
-double ratio_bound(const std::array<double, 27>& b) {
-  const auto [lo, hi] = std::minmax_element(b.begin(), b.end());
-  if (!(*hi > 0)) return *hi == 0 && *lo == 0 ? 0.0 : -1.0;
-  return std::max(-1.0, *lo / *hi);
+double ratio_bound(const Extremes& e) {
+  if (!(e.max_b > 0)) return e.max_b == 0 && e.min_b == 0 ? 0.0 : -1.0;
+  return std::max(-1.0, e.min_b / e.max_b);
 }
 
 // min / max clamped to [-1, 1]; an element negative everywhere is -1, a flat one 0.
@@ -301,17 +411,7 @@ double ratio_of(const JacobianBounds& b) {
 
 }  // namespace
 
-void lattice_to_bernstein(std::array<double, 27>& f) {
-  // Per axis, the quadratic through the values at 0, 1/2, 1 has Bernstein coefficients
-  // f(0), 2 f(1/2) - (f(0) + f(1))/2, f(1).
-  const auto line = [&](int a, int b, int c) { f[b] = 2 * f[b] - 0.5 * (f[a] + f[c]); };
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j < 3; ++j) line(3 * j + 9 * k, 1 + 3 * j + 9 * k, 2 + 3 * j + 9 * k);
-  for (int k = 0; k < 3; ++k)
-    for (int i = 0; i < 3; ++i) line(i + 9 * k, i + 3 + 9 * k, i + 6 + 9 * k);
-  for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i) line(i + 3 * j, i + 3 * j + 9, i + 3 * j + 18);
-}
+void lattice_to_bernstein(std::array<double, 27>& f) { lattice_to_bernstein_body(f.data()); }
 
 double jacobian_determinant(const std::array<Vec3, 8>& p, double u, double v, double w) {
   return det_at(relative(p), u, v, w);
@@ -346,19 +446,18 @@ namespace {
 bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivisions, double ratio_floor,
                      double* ratio = nullptr) {
   // A non-finite corner is never valid (bernstein_box()'s whole-element path does not carry a
-  // NaN into every coefficient, and min_element() cannot see one).
+  // NaN into every coefficient, and an infinite one would pass the floor).
   if (!all_finite(p)) {
     if (ratio) *ratio = -1;
     return false;
   }
   const std::array<Vec3, 8> q = relative(p);
   std::array<double, 27> s;
-  const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
-  const bool wanted = ratio || ratio_floor > -std::numeric_limits<double>::infinity();
-  const double rb = wanted ? ratio_bound(b) : 0.0;
+  const Extremes e = extremes(bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s), s);
+  const double rb = ratio_bound(e);
   if (ratio) *ratio = rb;
-  if (wanted && rb < ratio_floor) return false;
-  return certify(q, b, s, floor, max_subdivisions);
+  if (rb < ratio_floor) return false;
+  return certify(q, e, floor, max_subdivisions);
 }
 
 }  // namespace
@@ -377,7 +476,11 @@ double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
   return certified_valid(p) ? sj : 0.0;
 }
 
-double jacobian_ratio_bound(const std::array<Vec3, 8>& p) { return ratio_bound(jacobian_bernstein(p)); }
+double jacobian_ratio_bound(const std::array<Vec3, 8>& p) {
+  std::array<double, 27> s;
+  const Extremes e = extremes(bernstein_box(relative(p), Vec3::Zero(), Vec3::Ones(), &s), s);
+  return std::isnan(e.min_s) ? -1.0 : ratio_bound(e);
+}
 
 CertifiedQuality certified_quality(const std::array<Vec3, 8>& p) {
   if (!all_finite(p)) {  // never certified (certified_above())
@@ -387,9 +490,9 @@ CertifiedQuality certified_quality(const std::array<Vec3, 8>& p) {
   }
   const std::array<Vec3, 8> q = relative(p);
   std::array<double, 27> s;
-  const std::array<double, 27> b = bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s);
-  CertifiedQuality r{scaled_jacobian(p), ratio_bound(b)};
-  if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0 && !certify(q, b, s, 0, kCertifySubdivisions)) r.scaled_jacobian = 0;
+  const Extremes e = extremes(bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s), s);
+  CertifiedQuality r{scaled_jacobian(p), ratio_bound(e)};
+  if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0 && !certify(q, e, 0, kCertifySubdivisions)) r.scaled_jacobian = 0;
   return r;
 }
 
