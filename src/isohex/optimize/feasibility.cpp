@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -241,27 +242,47 @@ void ratio_coefficients(const std::array<Vec3, 8>& p, double weight, double norm
   }
 }
 
+namespace {
+
+// Bit k of kFrameCorners()[t]: frame t sees corner k (a non-zero coefficient). A table, not
+// frame_coefficient() per corner: find_infeasible() asks it for every free vertex's frames.
+const std::array<std::uint8_t, kFrames>& frame_corners() {
+  static const std::array<std::uint8_t, kFrames> mask = [] {
+    std::array<std::uint8_t, kFrames> m{};
+    for (int t = 0; t < kFrames; ++t)
+      for (int k = 0; k < 8; ++k)
+        if (!frame_coefficient(t, k).isZero()) m[static_cast<std::size_t>(t)] |= static_cast<std::uint8_t>(1u << k);
+    return m;
+  }();
+  return mask;
+}
+
+}  // namespace
+
 std::vector<Affine> vertex_frames(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                                   const std::vector<std::uint8_t>* fixed, const std::vector<std::uint8_t>* skip,
                                   std::vector<Index>* hex_of) {
+  const std::array<std::uint8_t, kFrames>& sees = frame_corners();
   std::vector<Affine> out;
   for (Index i = inc.offsets[v]; i < inc.offsets[v + 1]; ++i) {
     const Index h = inc.ids[i];
     if (skip && (*skip)[h]) continue;
     const Hex& hx = mesh.hexes[h];
-    const auto p = mesh.corners(h);
     int k = 0;
     while (hx[k] != v) ++k;
+    // The corners of h that are free, v's own excepted (all of them without `fixed`).
+    unsigned free_others = 0;
+    for (int j = 0; j < 8; ++j)
+      if (j != k && (!fixed || !(*fixed)[hx[j]])) free_others |= 1u << j;
     const double il = inv_len[h];
+    std::array<Vec3, 8> p;
+    bool have_corners = false;
     for (int t = 0; t < kFrames; ++t) {
+      const unsigned m = sees[static_cast<std::size_t>(t)];
+      if (!((m >> k) & 1u)) continue;          // frame t does not see v
+      if (fixed && (m & free_others)) continue;  // v is not its only free vertex
+      if (!have_corners) p = mesh.corners(h), have_corners = true;
       const Vec3& c = frame_coefficient(t, k);
-      if (c.isZero()) continue;
-      if (fixed) {
-        bool alone = true;
-        for (int j = 0; j < 8; ++j)
-          if (j != k && !frame_coefficient(t, j).isZero() && !(*fixed)[hx[j]]) alone = false;
-        if (!alone) continue;
-      }
       const Mat3 A = frame(p, t, il);
       Affine a;
       a.b = A.determinant();

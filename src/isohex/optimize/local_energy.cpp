@@ -304,18 +304,19 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     for (int t = 0; t < frames; ++t) {
       const Vec3& c = kCoef[t][k];
       if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
-      const std::size_t j = batch.add();
+      // The frame's fields, four apart (its lane of a block): one address, not one per field.
+      double* f = &batch.at(batch.add(), 0);
       if (t < 8) {  // corner_frame()'s entries, written in place
         const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
         for (int col = 0; col < 3; ++col)
-          for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kA + r + 3 * col) = (p[nb[col]][r] - p[t][r]) * hf.il;
+          for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kA + r + 3 * col)] = (p[nb[col]][r] - p[t][r]) * hf.il;
       } else {
         const Mat3 A = t == kCentreFrame ? frame(p, t, hf.il) : interior[static_cast<std::size_t>(t - kFrames)];
-        for (int e = 0; e < 9; ++e) batch.at(j, FrameBatch::kA + e) = A.data()[e];
+        for (int e = 0; e < 9; ++e) f[4 * (FrameBatch::kA + e)] = A.data()[e];
       }
-      for (int r = 0; r < 3; ++r) batch.at(j, FrameBatch::kC + r) = c[r];
-      batch.at(j, FrameBatch::kIl) = hf.il, batch.at(j, FrameBatch::kSq) = kCoefSq[t][k], batch.at(j, FrameBatch::kEps) = hf.eps;
-      batch.at(j, FrameBatch::kConstraint) = !params.untangle && t >= kCentreFrame;
+      for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kC + r)] = c[r];
+      f[4 * FrameBatch::kIl] = hf.il, f[4 * FrameBatch::kSq] = kCoefSq[t][k], f[4 * FrameBatch::kEps] = hf.eps;
+      f[4 * FrameBatch::kConstraint] = !params.untangle && t >= kCentreFrame;
     }
     hf.last = batch.size;
     bernstein = bernstein || hf.bernstein;
@@ -324,37 +325,58 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
   // The sums in frame order, hex by hex (a hex's Bernstein terms after its frames): those of
   // one frame at a time, bit for bit. H: its lower triangle (all the eigensolver reads), then
   // mirrored.
+  // g and H are summed in locals (through the pointers, every add was a load and a store:
+  // they might alias the batch), in the same order, and written back before a Bernstein
+  // term adds to them and at the end.
   double e = 0;
+  Vec3 gs = Vec3::Zero();
+  double hs[3][3] = {};
+  const auto flush = [&] {
+    if (g) *g = gs;
+    if (H)
+      for (int c = 0; c < 3; ++c)
+        for (int r = c; r < 3; ++r) (*H)(r, c) = hs[r][c];
+  };
+  const auto reload = [&] {
+    if (g) gs = *g;
+    if (H)
+      for (int c = 0; c < 3; ++c)
+        for (int r = c; r < 3; ++r) hs[r][c] = (*H)(r, c);
+  };
   for (const HexFrames& hf : hexes) {
     for (std::size_t j = hf.first; j < hf.last; ++j) {
+      const double* f = &batch.at(j, 0);
       // The shape stage's centre and interior frames only constrain: no derivatives.
-      const bool constraint = batch.at(j, FrameBatch::kConstraint) != 0;
-      const double D = batch.at(j, FrameBatch::kD);
-      e += constraint ? (D > kMinFeasibleDet ? 0.0 : kInf) : batch.at(j, FrameBatch::kValue);
+      const bool constraint = f[4 * FrameBatch::kConstraint] != 0;
+      const double D = f[4 * FrameBatch::kD];
+      e += constraint ? (D > kMinFeasibleDet ? 0.0 : kInf) : f[4 * FrameBatch::kValue];
       if (!std::isfinite(e)) return kInf;
       if (!g) continue;
       if (model && bernstein)  // terms to interleave: copied one by one
-        model->push(batch.at(j, FrameBatch::kF), D, batch.at(j, FrameBatch::kCc), hf.eps,
-                    Vec3(batch.at(j, FrameBatch::kGF), batch.at(j, FrameBatch::kGF + 1), batch.at(j, FrameBatch::kGF + 2)),
-                    Vec3(batch.at(j, FrameBatch::kGD), batch.at(j, FrameBatch::kGD + 1), batch.at(j, FrameBatch::kGD + 2)),
+        model->push(f[4 * FrameBatch::kF], D, f[4 * FrameBatch::kCc], hf.eps,
+                    Vec3(f[4 * FrameBatch::kGF], f[4 * (FrameBatch::kGF + 1)], f[4 * (FrameBatch::kGF + 2)]),
+                    Vec3(f[4 * FrameBatch::kGD], f[4 * (FrameBatch::kGD + 1)], f[4 * (FrameBatch::kGD + 2)]),
                     constraint);
       if (constraint) continue;
-      for (int i = 0; i < 3; ++i) (*g)[i] += batch.at(j, FrameBatch::kGrad + i);
+      for (int i = 0; i < 3; ++i) gs[i] += f[4 * (FrameBatch::kGrad + i)];
       if (!H) continue;
-      const double id = batch.at(j, FrameBatch::kIdentity);
+      const double id = f[4 * FrameBatch::kIdentity];
       int n = FrameBatch::kHessian;
       for (int c = 0; c < 3; ++c) {
-        (*H)(c, c) += id;
-        for (int r = c; r < 3; ++r) (*H)(r, c) += batch.at(j, n++);
+        hs[c][c] += id;
+        for (int r = c; r < 3; ++r) hs[r][c] += f[4 * n++];
       }
     }
     if (hf.bernstein) {
       std::array<Vec3, 8> p = mesh.corners(hf.h);
       p[hf.k] = x;
+      flush();
       e += bernstein_energy(p, hf.k, hf.il, params, hf.eps, g, H, model);
+      reload();
       if (!std::isfinite(e)) return kInf;
     }
   }
+  flush();
   if (H)
     for (int c = 0; c < 3; ++c)
       for (int r = c + 1; r < 3; ++r) (*H)(c, r) = (*H)(r, c);

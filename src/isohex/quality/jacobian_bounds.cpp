@@ -46,6 +46,11 @@ bool all_finite(const std::array<Vec3, 8>& p) {
 #endif
 }
 
+// GCC's vector extensions (AVX where the kernel's clone has it, SSE pairs otherwise); only
+// inside always-inline bodies, so no vector crosses a call.
+#pragma GCC diagnostic ignored "-Wpsabi"
+using d4 = double __attribute__((vector_size(32)));
+
 // The smallest and largest Bernstein coefficient and the smallest sample of a box, in one pass
 // (two lanes at a time: every certificate reads them). A non-finite value anywhere (an
 // overflow) makes min_s NaN: never certified.
@@ -171,12 +176,17 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
   x[5] = 0.5 * b + 0.5 * d;
 }
 
-// The whole element (most calls): det J at its lattice (`samples`) and its Bernstein
-// coefficients (`coef`). edge_u() and the others at 0, 1/2 and 1 are its edges and their halves
-// and quarters, per component straight into the lanes: the same sums in the same order as
-// det_at(), without the zero terms (tested bit for bit). Every certificate runs this.
-[[gnu::always_inline]] inline void whole_element_body(const std::array<Vec3, 8>& q, double* samples, double* coef) {
-  alignas(64) double U[3][28], V[3][28], W[3][28];
+// The whole element (most calls), four lanes along u: lattice point (i, j, k) is lane i of
+// vector j + 3k (lane 3 a zero pad), so that xu[j + 3k] is one broadcast and xv[i + 3k],
+// xw[i + 3j] are three vectors each, with no shuffling of 27 lanes through memory; the
+// Bernstein passes along v and w are whole-vector operations. edge_u() and the others at 0,
+// 1/2 and 1 are the element's edges and their halves and quarters: the same sums in the same
+// order as det_at() without the zero terms, and each lane the same triple product and the
+// same pass as the scalar code, so the same bits (tested). Returns the extremes of the
+// samples and coefficients; writes them to `samples` and `coef` where those are not null.
+// Every certificate runs this.
+[[gnu::always_inline]] inline Extremes whole_element_body(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  d4 U[3][9], V[3][3], W[3][3];
   for (int c = 0; c < 3; ++c) {
     double u[9], v[9], w[9];
     const double ua = q[1][c] - q[0][c], ub = q[2][c] - q[3][c], uc = q[5][c] - q[4][c], ud = q[6][c] - q[7][c];
@@ -188,11 +198,52 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
     v[4] = 0.25 * va + 0.25 * vb + 0.25 * vc + 0.25 * vd;
     unit_lattice(wa, wb, wc, wd, w);
     w[4] = 0.25 * wa + 0.25 * wb + 0.25 * wd + 0.25 * wc;
-    spread(c, u, v, w, U, V, W);
+    for (int m = 0; m < 9; ++m) U[c][m] = d4{u[m], u[m], u[m], u[m]};
+    for (int t = 0; t < 3; ++t) {
+      V[c][t] = d4{v[3 * t], v[3 * t + 1], v[3 * t + 2], 0.0};
+      W[c][t] = d4{w[3 * t], w[3 * t + 1], w[3 * t + 2], 0.0};
+    }
   }
-  triple_products(U, V, W, samples);
-  for (int n = 0; n < 27; ++n) coef[n] = samples[n];
-  lattice_to_bernstein_body(coef);
+  d4 S[9];
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) {
+      const int m = j + 3 * k;
+      const d4 cx = V[1][k] * W[2][j] - V[2][k] * W[1][j];
+      const d4 cy = V[2][k] * W[0][j] - V[0][k] * W[2][j];
+      const d4 cz = V[0][k] * W[1][j] - V[1][k] * W[0][j];
+      S[m] = U[0][m] * cx + U[1][m] * cy + U[2][m] * cz;
+    }
+  Extremes e;
+  // lane 3 (the pad) takes lane 0's value: it changes no minimum or maximum
+  const auto real = [](d4 x) { return d4{x[0], x[1], x[2], x[0]}; };
+  d4 lo = real(S[0]), acc{0, 0, 0, 0};
+  for (int m = 0; m < 9; ++m) {
+    const d4 x = real(S[m]);
+    lo = x < lo ? x : lo;
+    acc += x;
+    if (samples)
+      for (int i = 0; i < 3; ++i) samples[3 * m + i] = S[m][i];
+  }
+  e.min_s = std::min(std::min(lo[0], lo[1]), lo[2]);
+  // lattice_to_bernstein(): along u within each vector, then along v and w between vectors
+  for (int m = 0; m < 9; ++m) S[m][1] = 2 * S[m][1] - 0.5 * (S[m][0] + S[m][2]);
+  for (int k = 0; k < 3; ++k) S[1 + 3 * k] = 2 * S[1 + 3 * k] - 0.5 * (S[3 * k] + S[2 + 3 * k]);
+  for (int j = 0; j < 3; ++j) S[j + 3] = 2 * S[j + 3] - 0.5 * (S[j] + S[j + 6]);
+  lo = real(S[0]);
+  d4 hi = lo;
+  for (int m = 0; m < 9; ++m) {
+    const d4 x = real(S[m]);
+    lo = x < lo ? x : lo;
+    hi = x > hi ? x : hi;
+    acc += x;
+    if (coef)
+      for (int i = 0; i < 3; ++i) coef[3 * m + i] = S[m][i];
+  }
+  e.min_b = std::min(std::min(lo[0], lo[1]), lo[2]);
+  e.max_b = std::max(std::max(hi[0], hi[1]), hi[2]);
+  if (!std::isfinite((acc[0] + acc[1]) + (acc[2] + acc[3]))) e.min_s = std::numeric_limits<double>::quiet_NaN();
+  if (e.min_b == 0) e.min_b = 0.0;  // +0 whichever zero came first: ratio_bound()'s sign
+  return e;
 }
 
 #if ISOHEX_HAVE_FMV
@@ -206,19 +257,19 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
                                           const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
   lattice_dets_body(xu, xv, xw, out);
 }
-[[gnu::target("default")]] void whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
-  whole_element_body(q, samples, coef);
+[[gnu::target("default")]] Extremes whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  return whole_element_body(q, samples, coef);
 }
-[[gnu::target("avx2")]] void whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
-  whole_element_body(q, samples, coef);
+[[gnu::target("avx2")]] Extremes whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  return whole_element_body(q, samples, coef);
 }
 #else
 void lattice_dets(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv, const std::array<Vec3, 9>& xw,
                   std::array<double, 27>& out) {
   lattice_dets_body(xu, xv, xw, out);
 }
-void whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
-  whole_element_body(q, samples, coef);
+Extremes whole_element(const std::array<Vec3, 8>& q, double* samples, double* coef) {
+  return whole_element_body(q, samples, coef);
 }
 #endif
 
@@ -229,8 +280,7 @@ std::array<double, 27> bernstein_box(const std::array<Vec3, 8>& q, const Vec3& l
                                      std::array<double, 27>* samples) {
   std::array<double, 27> b;
   if (lo == Vec3::Zero() && hi == Vec3::Ones()) {
-    std::array<double, 27> s;
-    whole_element(q, samples ? samples->data() : s.data(), b.data());
+    whole_element(q, samples ? samples->data() : nullptr, b.data());
     return b;
   }
   const Vec3 mid = 0.5 * (lo + hi);
@@ -452,8 +502,7 @@ bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivi
     return false;
   }
   const std::array<Vec3, 8> q = relative(p);
-  std::array<double, 27> s;
-  const Extremes e = extremes(bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s), s);
+  const Extremes e = whole_element(q, nullptr, nullptr);
   const double rb = ratio_bound(e);
   if (ratio) *ratio = rb;
   if (rb < ratio_floor) return false;
@@ -477,8 +526,7 @@ double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
 }
 
 double jacobian_ratio_bound(const std::array<Vec3, 8>& p) {
-  std::array<double, 27> s;
-  const Extremes e = extremes(bernstein_box(relative(p), Vec3::Zero(), Vec3::Ones(), &s), s);
+  const Extremes e = whole_element(relative(p), nullptr, nullptr);
   return std::isnan(e.min_s) ? -1.0 : ratio_bound(e);
 }
 
@@ -489,8 +537,7 @@ CertifiedQuality certified_quality(const std::array<Vec3, 8>& p) {
     return r;
   }
   const std::array<Vec3, 8> q = relative(p);
-  std::array<double, 27> s;
-  const Extremes e = extremes(bernstein_box(q, Vec3::Zero(), Vec3::Ones(), &s), s);
+  const Extremes e = whole_element(q, nullptr, nullptr);
   CertifiedQuality r{scaled_jacobian(p), ratio_bound(e)};
   if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0 && !certify(q, e, 0, kCertifySubdivisions)) r.scaled_jacobian = 0;
   return r;
