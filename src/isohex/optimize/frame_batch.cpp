@@ -158,6 +158,35 @@ const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
   }
 }
 
+// The sum of a hex's eight corner shape terms (frames 0..7 of frame(), the shape objective's
+// terms), four corners at a time: each lane the scalar term_value()'s expressions (Eigen's
+// orders for squaredNorm() and determinant(), shape_term()), summed in corner order, so the
+// same bits. The shape stage evaluates every changed hex's energy after each sweep.
+[[gnu::always_inline]] inline double corner_shape_body(const std::array<Vec3, 8>& p, double il) {
+  double f[8];
+  for (int half = 0; half < 2; ++half) {
+    d4 a[9];
+    for (int col = 0; col < 3; ++col)
+      for (int r = 0; r < 3; ++r) {
+        d4 x;
+        for (int l = 0; l < 4; ++l) {
+          const int t = 4 * half + l;
+          x[l] = (p[kCornerNeighbors[static_cast<std::size_t>(t)][static_cast<std::size_t>(col)]][r] - p[t][r]) * il;
+        }
+        a[r + 3 * col] = x;
+      }
+    const d4 F = (((a[0] * a[0] + a[2] * a[2]) + (a[4] * a[4] + a[6] * a[6])) +
+                  ((a[1] * a[1] + a[3] * a[3]) + (a[5] * a[5] + a[7] * a[7]))) +
+                 a[8] * a[8];
+    const d4 D = (a[0] * (a[4] * a[8] - a[7] * a[5]) - a[3] * (a[1] * a[8] - a[7] * a[2])) +
+                 a[6] * (a[1] * a[5] - a[4] * a[2]);
+    store(f + 4 * half, shape_term(F, D).f);
+  }
+  double e = 0;
+  for (double x : f) e += x;
+  return e;
+}
+
 #if ISOHEX_HAVE_FMV
 // AVX2 where the CPU has it (no FMA: the same bits as the baseline's SSE2 pairs).
 [[gnu::target("default")]] void frames_kernel(double* data, std::size_t blocks, bool untangle, double lambda) {
@@ -182,7 +211,14 @@ const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
 }
 [[gnu::target("default")]] void lattice_kernel(LatticeFrames& f, bool gradients) { lattice_body(f, gradients); }
 [[gnu::target("avx2")]] void lattice_kernel(LatticeFrames& f, bool gradients) { lattice_body(f, gradients); }
+[[gnu::target("default")]] double corner_shape_kernel(const std::array<Vec3, 8>& p, double il) {
+  return corner_shape_body(p, il);
+}
+[[gnu::target("avx2")]] double corner_shape_kernel(const std::array<Vec3, 8>& p, double il) {
+  return corner_shape_body(p, il);
+}
 #else
+double corner_shape_kernel(const std::array<Vec3, 8>& p, double il) { return corner_shape_body(p, il); }
 void lattice_kernel(LatticeFrames& f, bool gradients) { lattice_body(f, gradients); }
 void interior_kernel(const RelativeCorners& d, double inv_len, Mat3* out, int first) {
   interior_body(d, inv_len, out, first);
@@ -205,6 +241,8 @@ void pad(FrameBatch& b) {
 }
 
 }  // namespace
+
+double corner_shape_energy(const std::array<Vec3, 8>& p, double inv_len) { return corner_shape_kernel(p, inv_len); }
 
 void FrameBatch::compute(bool untangle, double lambda) {
   pad(*this);

@@ -215,6 +215,12 @@ double hex_energy(const std::array<Vec3, 8>& p, double inv_len, const EnergyPara
 }
 
 double hex_energy(const std::array<Vec3, 8>& p, Index h, double inv_len, const EnergyParams& params) {
+  if (!params.untangle && params.frames_of(h) == kFrames && !params.bernstein_of(h)) {
+    // The shape objective's hex (every hex of the shape stage): its corner terms four at a
+    // time, then the centre frame's constraint, as the loop below adds them.
+    const double e = corner_shape_energy(p, inv_len);
+    return e + (frame(p, kCentreFrame, inv_len).determinant() > kMinFeasibleDet ? 0.0 : kInf);
+  }
   const double eps = params.eps_of(h);
   double e = hex_energy(p, inv_len, params, eps, params.frames_of(h));
   if (params.bernstein_of(h)) e += bernstein_energy(p, 0, inv_len, params, eps, nullptr, nullptr);

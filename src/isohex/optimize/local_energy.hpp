@@ -107,6 +107,10 @@ inline double inverse_cbrt(double x) {
   return y;
 }
 
+/// Σ_{t<8} of the shape term of corner frame t of p (scaled by inv_len), in t order: the first
+/// eight terms of the shape objective's hex_energy(), the same bits, four frames at a time.
+double corner_shape_energy(const std::array<Vec3, 8>& p, double inv_len);
+
 /// Per-hex 1/L, L = mean edge length (fixed for the length of a stage).
 std::vector<double> inverse_edge_lengths(const HexMesh& mesh);
 

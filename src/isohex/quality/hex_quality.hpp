@@ -131,4 +131,8 @@ std::vector<double> hex_metric(const HexMesh& mesh, HexMetric m);
 /// a valid index into mesh.points.
 std::vector<double> scaled_jacobians(const HexMesh& mesh);
 
+/// The same for the hexes `ids` only, in that order (the optimisers' changed hexes after a
+/// sweep): out[i] = scaled_jacobian(mesh.corners(ids[i])), bit for bit.
+std::vector<double> scaled_jacobians(const HexMesh& mesh, const std::vector<Index>& ids);
+
 }  // namespace isohex

@@ -246,6 +246,20 @@ std::vector<double> scaled_jacobians(const HexMesh& mesh) {
   return out;
 }
 
+std::vector<double> scaled_jacobians(const HexMesh& mesh, const std::vector<Index>& ids) {
+  const std::size_t n = ids.size();
+  std::vector<double> out(n);
+  if (n == 0) return out;
+  std::vector<Hex> picked(n);  // the kernel reads hexes side by side
+  for (std::size_t i = 0; i < n; ++i) picked[i] = mesh.hexes[static_cast<std::size_t>(ids[i])];
+  const double* pts = mesh.points.empty() ? nullptr : mesh.points.front().data();
+  const Hex* hexes = picked.data();
+  double* dst = out.data();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain),
+                    [=](const tbb::blocked_range<std::size_t>& r) { sj_range(pts, hexes, r.begin(), r.end(), dst); });
+  return out;
+}
+
 std::vector<double> hex_metric(const HexMesh& mesh, HexMetric m) {
   if (m == HexMetric::scaled_jacobian) return scaled_jacobians(mesh);
   std::vector<double> out(mesh.hexes.size());
