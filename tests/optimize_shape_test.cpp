@@ -18,6 +18,7 @@
 #include <numeric>
 #include <random>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <set>
 
@@ -86,6 +87,34 @@ TEST(OptimizeShape, DerivativesMatchFiniteDifferences) {
   EXPECT_GT(std::abs(opt::vertex_energy(m, inc, il, v, m.points[v], b) -
                      opt::vertex_energy(m, inc, il, v, m.points[v], frames_only)),
             1e-6);
+}
+
+// hex_energy() of the shape objective sums its eight corner terms four at a time
+// (corner_shape_energy()): the same bits as term by term in corner order, for valid hexes and
+// for hexes with a flat or inverted corner (an infinite term). Fails if a lane's arithmetic
+// leaves the scalar order or the sum is regrouped.
+TEST(OptimizeShape, CornerShapeTermsFourAtATimeGiveTheScalarBits) {
+  HexMesh m = jittered_box(4, 0.45, 13);
+  const std::vector<double> il = opt::inverse_edge_lengths(m);
+  std::size_t infinite = 0;
+  for (Index h = 0; h < m.num_hexes(); ++h) {
+    const std::array<Vec3, 8> p = m.corners(h);
+    double ref = 0;
+    for (int t = 0; t < 8; ++t) {
+      const opt::Mat3 A = opt::frame(p, t, il[h]);
+      ref += opt::shape_term(A.squaredNorm(), A.determinant()).f;
+    }
+    const double got = opt::corner_shape_energy(p, il[h]);
+    EXPECT_EQ(std::memcmp(&got, &ref, sizeof got), 0) << "hex " << h << ": " << got << " vs " << ref;
+    infinite += std::isinf(ref);
+    // ... and hex_energy(), which takes this path for the shape objective, adds the centre
+    // frame's constraint as its frame-by-frame loop does.
+    const double whole = opt::hex_energy(p, h, il[h], opt::EnergyParams{});
+    const double loop = opt::hex_energy(p, il[h], opt::EnergyParams{}, -1, opt::kFrames);
+    EXPECT_EQ(std::memcmp(&whole, &loop, sizeof whole), 0) << "hex " << h;
+  }
+  EXPECT_GT(infinite, 0u);  // jitter 0.45 inverts some corners
+  EXPECT_LT(infinite, static_cast<std::size_t>(m.num_hexes()));
 }
 
 // vertex_energy() evaluates its frames four at a time (FrameBatch): the same bits as a loop

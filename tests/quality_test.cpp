@@ -406,6 +406,25 @@ TEST(Quality, FastPathReturnsTheScalarBits) {
   EXPECT_EQ(scaled_jacobians(one), std::vector<double>{1.0});
 }
 
+// The batch kernel over a list of hexes (the shape stage's changed hexes after a sweep): each
+// value the scalar function's bits, in the list's order, repeats and non-finite corners
+// included. Fails if the list's hexes are not the ones computed, or in another order.
+TEST(Quality, FastPathOverAListOfHexesReturnsTheScalarBits) {
+  HexMesh m = random_hexes(5003, 29);
+  m.points[8 * 40 + 1].x() = std::numeric_limits<double>::quiet_NaN();
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<Index> pick(0, m.num_hexes() - 1);
+  std::vector<Index> ids{40, 40, 0};
+  for (int i = 0; i < 9000; ++i) ids.push_back(pick(rng));
+  const std::vector<double> fast = scaled_jacobians(m, ids);
+  ASSERT_EQ(fast.size(), ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const double ref = scaled_jacobian(m.corners(ids[i]));
+    ASSERT_TRUE(same_bits(fast[i], ref)) << "entry " << i << " (hex " << ids[i] << "): " << fast[i] << " vs " << ref;
+  }
+  EXPECT_TRUE(scaled_jacobians(m, {}).empty());
+}
+
 TEST(Quality, WholeMeshValuesAreBitIdenticalForAnyThreadCount) {
   HexMesh m = test::grid_mesh(40, 40, 40, 0.5);
   std::mt19937_64 rng(23);
