@@ -27,6 +27,16 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
   return load(&x[static_cast<std::size_t>(4 * block)]);
 }
 
+// |A|² and det A of four frames at once (A(r, c) = a[r + 3c] lane by lane), in the orders of
+// Eigen's squaredNorm() and determinant() for a 3×3 matrix: each lane the scalar bits.
+[[gnu::always_inline]] inline d4 squared_norms(const d4 (&a)[9]) {
+  return (((a[0] * a[0] + a[2] * a[2]) + (a[4] * a[4] + a[6] * a[6])) + ((a[1] * a[1] + a[3] * a[3]) + (a[5] * a[5] + a[7] * a[7]))) +
+         a[8] * a[8];
+}
+[[gnu::always_inline]] inline d4 determinants(const d4 (&a)[9]) {
+  return (a[0] * (a[4] * a[8] - a[7] * a[5]) - a[3] * (a[1] * a[8] - a[7] * a[2])) + a[6] * (a[1] * a[5] - a[4] * a[2]);
+}
+
 // One block of four frames. Each expression is the one the scalar code evaluated (Eigen's
 // orders for a 3×3 matrix's squaredNorm(), determinant(), A·c and cross products; the
 // gradient of a corner's own frame or of a unit coefficient is this general form with its
@@ -34,12 +44,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 template <bool kUntangle>
 [[gnu::always_inline]] inline void frame_block(double* b, double lambda) {
   using F_ = FrameBatch;
-  const d4 a0 = field(b, F_::kA), a1 = field(b, F_::kA + 1), a2 = field(b, F_::kA + 2), a3 = field(b, F_::kA + 3), a4 = field(b, F_::kA + 4),
-           a5 = field(b, F_::kA + 5), a6 = field(b, F_::kA + 6), a7 = field(b, F_::kA + 7), a8 = field(b, F_::kA + 8);
+  d4 a[9];
+  for (int e = 0; e < 9; ++e) a[e] = field(b, F_::kA + e);
+  const d4 a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6], a7 = a[7], a8 = a[8];
   const d4 c0 = field(b, F_::kC), c1 = field(b, F_::kC + 1), c2 = field(b, F_::kC + 2);
   const d4 il = field(b, F_::kIl), sq = field(b, F_::kSq);
-  const d4 F = (((a0 * a0 + a2 * a2) + (a4 * a4 + a6 * a6)) + ((a1 * a1 + a3 * a3) + (a5 * a5 + a7 * a7))) + a8 * a8;
-  const d4 D = (a0 * (a4 * a8 - a7 * a5) - a3 * (a1 * a8 - a7 * a2)) + a6 * (a1 * a5 - a4 * a2);
+  const d4 F = squared_norms(a), D = determinants(a);
   // ∇F = 2·il·A·c (Eigen's scaled product: the factor on A's entries, rows 0 and 1 summed left
   // to right, row 2 its last two first)
   const d4 il2 = 2.0 * il;
@@ -144,11 +154,10 @@ const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
 // Eigen's determinant() and of det_gradient()'s expression: the same bits.
 [[gnu::always_inline]] inline void lattice_body(LatticeFrames& f, bool gradients) {
   for (int b = 0; b < LatticeFrames::kBlocks; ++b) {
-    const d4 a0 = lanes(b, f.a[0]), a1 = lanes(b, f.a[1]), a2 = lanes(b, f.a[2]), a3 = lanes(b, f.a[3]),
-             a4 = lanes(b, f.a[4]), a5 = lanes(b, f.a[5]), a6 = lanes(b, f.a[6]), a7 = lanes(b, f.a[7]),
-             a8 = lanes(b, f.a[8]);
-    store(&f.det[static_cast<std::size_t>(4 * b)],
-          (a0 * (a4 * a8 - a7 * a5) - a3 * (a1 * a8 - a7 * a2)) + a6 * (a1 * a5 - a4 * a2));
+    d4 a[9];
+    for (int e = 0; e < 9; ++e) a[e] = lanes(b, f.a[static_cast<std::size_t>(e)]);
+    const d4 a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6], a7 = a[7], a8 = a[8];
+    store(&f.det[static_cast<std::size_t>(4 * b)], determinants(a));
     if (!gradients) continue;
     const d4 c0 = lanes(b, f.c[0]), c1 = lanes(b, f.c[1]), c2 = lanes(b, f.c[2]);
     const d4 x[3] = {a4 * a8 - a5 * a7, a5 * a6 - a3 * a8, a3 * a7 - a4 * a6};  // col1 × col2
@@ -175,12 +184,7 @@ const std::array<double, kInteriorBlocks * 8 * 3 * 4>& dense_coef() {
         }
         a[r + 3 * col] = x;
       }
-    const d4 F = (((a[0] * a[0] + a[2] * a[2]) + (a[4] * a[4] + a[6] * a[6])) +
-                  ((a[1] * a[1] + a[3] * a[3]) + (a[5] * a[5] + a[7] * a[7]))) +
-                 a[8] * a[8];
-    const d4 D = (a[0] * (a[4] * a[8] - a[7] * a[5]) - a[3] * (a[1] * a[8] - a[7] * a[2])) +
-                 a[6] * (a[1] * a[5] - a[4] * a[2]);
-    store(f + 4 * half, shape_term(F, D).f);
+    store(f + 4 * half, shape_term(squared_norms(a), determinants(a)).f);
   }
   double e = 0;
   for (double x : f) e += x;
