@@ -280,6 +280,68 @@ struct HexFrames {
 
 }  // namespace
 
+namespace {
+
+// Appends to `batch` the frames of hex hf (corners p, the vertex at corner hf.k) that see the
+// vertex: the others' terms are constants of its place.
+[[gnu::always_inline]] inline void add_frames(const std::array<Vec3, 8>& p, const HexFrames& hf, int frames,
+                                              bool untangle, FrameBatch& batch) {
+  const int k = hf.k;
+  InteriorFrames interior;  // the hex's 26 interior frames, at once
+  if (frames > kFrames) interior_frames(relative_corners(p), hf.il, interior);
+  for (int t = 0; t < frames; ++t) {
+    const Vec3& c = kCoef[t][k];
+    if (c.isZero()) continue;
+    // The frame's fields, four apart (its lane of a block): one address, not one per field.
+    double* f = &batch.at(batch.add(), 0);
+    if (t < 8) {  // corner_frame()'s entries, written in place
+      const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
+      for (int col = 0; col < 3; ++col)
+        for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kA + r + 3 * col)] = (p[nb[col]][r] - p[t][r]) * hf.il;
+    } else {
+      const Mat3 A = t == kCentreFrame ? frame(p, t, hf.il) : interior[static_cast<std::size_t>(t - kFrames)];
+      for (int e = 0; e < 9; ++e) f[4 * (FrameBatch::kA + e)] = A.data()[e];
+    }
+    for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kC + r)] = c[r];
+    f[4 * FrameBatch::kIl] = hf.il, f[4 * FrameBatch::kSq] = kCoefSq[t][k], f[4 * FrameBatch::kEps] = hf.eps;
+    f[4 * FrameBatch::kConstraint] = !untangle && t >= kCentreFrame;
+  }
+}
+
+// g and H (its lower triangle, all the eigensolver reads) summed frame by frame in locals:
+// through the caller's pointers every add was a load and a store (they might alias the
+// batch). The same additions in the same order; stored before a Bernstein term adds to the
+// caller's and loaded back after.
+struct Derivatives {
+  Vec3 g = Vec3::Zero();
+  double h[3][3] = {};
+  // A frame's gradient and Hessian terms (f: its fields, four apart).
+  void add(const double* f, bool hessian) {
+    for (int i = 0; i < 3; ++i) g[i] += f[4 * (FrameBatch::kGrad + i)];
+    if (!hessian) return;
+    const double id = f[4 * FrameBatch::kIdentity];
+    int n = FrameBatch::kHessian;
+    for (int c = 0; c < 3; ++c) {
+      h[c][c] += id;
+      for (int r = c; r < 3; ++r) h[r][c] += f[4 * n++];
+    }
+  }
+  void store(Vec3* gp, Mat3* Hp) const {
+    if (gp) *gp = g;
+    if (Hp)
+      for (int c = 0; c < 3; ++c)
+        for (int r = c; r < 3; ++r) (*Hp)(r, c) = h[r][c];
+  }
+  void load(const Vec3* gp, const Mat3* Hp) {
+    if (gp) g = *gp;
+    if (Hp)
+      for (int c = 0; c < 3; ++c)
+        for (int r = c; r < 3; ++r) h[r][c] = (*Hp)(r, c);
+  }
+};
+
+}  // namespace
+
 double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vector<double>& inv_len, Index v,
                      const Vec3& x, const EnergyParams& params, Vec3* g, Mat3* H, TermModels* model) {
   if (!g) model = nullptr;
@@ -304,26 +366,7 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     HexFrames& hf = hexes.emplace_back();
     hf.h = h, hf.k = k, hf.il = inv_len[h], hf.eps = params.eps_of(h), hf.first = batch.size;
     hf.bernstein = params.bernstein_of(h);
-    const int frames = params.frames_of(h);
-    InteriorFrames interior;  // the hex's 26 interior frames, at once
-    if (frames > kFrames) interior_frames(relative_corners(p), hf.il, interior);
-    for (int t = 0; t < frames; ++t) {
-      const Vec3& c = kCoef[t][k];
-      if (c.isZero()) continue;  // frame t does not see vertex v: its term is a constant
-      // The frame's fields, four apart (its lane of a block): one address, not one per field.
-      double* f = &batch.at(batch.add(), 0);
-      if (t < 8) {  // corner_frame()'s entries, written in place
-        const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
-        for (int col = 0; col < 3; ++col)
-          for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kA + r + 3 * col)] = (p[nb[col]][r] - p[t][r]) * hf.il;
-      } else {
-        const Mat3 A = t == kCentreFrame ? frame(p, t, hf.il) : interior[static_cast<std::size_t>(t - kFrames)];
-        for (int e = 0; e < 9; ++e) f[4 * (FrameBatch::kA + e)] = A.data()[e];
-      }
-      for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kC + r)] = c[r];
-      f[4 * FrameBatch::kIl] = hf.il, f[4 * FrameBatch::kSq] = kCoefSq[t][k], f[4 * FrameBatch::kEps] = hf.eps;
-      f[4 * FrameBatch::kConstraint] = !params.untangle && t >= kCentreFrame;
-    }
+    add_frames(p, hf, params.frames_of(h), params.untangle, batch);
     hf.last = batch.size;
     bernstein = bernstein || hf.bernstein;
   }
@@ -331,24 +374,8 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
   // The sums in frame order, hex by hex (a hex's Bernstein terms after its frames): those of
   // one frame at a time, bit for bit. H: its lower triangle (all the eigensolver reads), then
   // mirrored.
-  // g and H are summed in locals (through the pointers, every add was a load and a store:
-  // they might alias the batch), in the same order, and written back before a Bernstein
-  // term adds to them and at the end.
   double e = 0;
-  Vec3 gs = Vec3::Zero();
-  double hs[3][3] = {};
-  const auto flush = [&] {
-    if (g) *g = gs;
-    if (H)
-      for (int c = 0; c < 3; ++c)
-        for (int r = c; r < 3; ++r) (*H)(r, c) = hs[r][c];
-  };
-  const auto reload = [&] {
-    if (g) gs = *g;
-    if (H)
-      for (int c = 0; c < 3; ++c)
-        for (int r = c; r < 3; ++r) hs[r][c] = (*H)(r, c);
-  };
+  Derivatives sums;
   for (const HexFrames& hf : hexes) {
     for (std::size_t j = hf.first; j < hf.last; ++j) {
       const double* f = &batch.at(j, 0);
@@ -363,26 +390,18 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
                     Vec3(f[4 * FrameBatch::kGF], f[4 * (FrameBatch::kGF + 1)], f[4 * (FrameBatch::kGF + 2)]),
                     Vec3(f[4 * FrameBatch::kGD], f[4 * (FrameBatch::kGD + 1)], f[4 * (FrameBatch::kGD + 2)]),
                     constraint);
-      if (constraint) continue;
-      for (int i = 0; i < 3; ++i) gs[i] += f[4 * (FrameBatch::kGrad + i)];
-      if (!H) continue;
-      const double id = f[4 * FrameBatch::kIdentity];
-      int n = FrameBatch::kHessian;
-      for (int c = 0; c < 3; ++c) {
-        hs[c][c] += id;
-        for (int r = c; r < 3; ++r) hs[r][c] += f[4 * n++];
-      }
+      if (!constraint) sums.add(f, H != nullptr);
     }
     if (hf.bernstein) {
       std::array<Vec3, 8> p = mesh.corners(hf.h);
       p[hf.k] = x;
-      flush();
+      sums.store(g, H);
       e += bernstein_energy(p, hf.k, hf.il, params, hf.eps, g, H, model);
-      reload();
+      sums.load(g, H);
       if (!std::isfinite(e)) return kInf;
     }
   }
-  flush();
+  sums.store(g, H);
   if (H)
     for (int c = 0; c < 3; ++c)
       for (int r = c + 1; r < 3; ++r) (*H)(c, r) = (*H)(r, c);
