@@ -168,6 +168,31 @@ TEST(JacobianBounds, FlatAndCollapsedElements) {
   EXPECT_FALSE(certified_valid(nan));
 }
 
+// The certificates take a non-finite corner anywhere (NaN, +inf, -inf in any coordinate of
+// any corner, corner 0 included: every other corner is taken relative to it) as not valid,
+// with a ratio bound of -1, whatever the floors: an infinite coefficient must never pass one.
+TEST(JacobianBounds, NonFiniteCornersAreNeverCertified) {
+  const double bad[] = {std::nan(""), std::numeric_limits<double>::infinity(),
+                        -std::numeric_limits<double>::infinity()};
+  for (int k = 0; k < 8; ++k)
+    for (int c = 0; c < 3; ++c)
+      for (double x : bad) {
+        Corners p = unit_cube();
+        p[k][c] = x;
+        EXPECT_FALSE(certified_valid(p)) << k << " " << c << " " << x;
+        EXPECT_FALSE(certified_valid(p, -1e300)) << k << " " << c << " " << x;
+        EXPECT_FALSE(certified_valid_above_ratio(p, -1e300, -std::numeric_limits<double>::infinity()));
+        double ratio = 0;
+        EXPECT_FALSE(certified_valid_above_ratio(p, 0, -2, &ratio));
+        EXPECT_EQ(ratio, -1.0) << k << " " << c << " " << x;
+        EXPECT_EQ(jacobian_ratio_bound(p), -1.0) << k << " " << c << " " << x;
+        const CertifiedQuality q = certified_quality(p);
+        EXPECT_EQ(q.ratio_bound, -1.0);
+        EXPECT_TRUE(!(q.scaled_jacobian > 0) || is_degenerate(q.scaled_jacobian)) << k << " " << c << " " << x;
+        EXPECT_TRUE(!(certified_scaled_jacobian(p) > 0) || is_degenerate(certified_scaled_jacobian(p)));
+      }
+}
+
 TEST(JacobianBounds, FloorIsRespected) {
   Corners p = unit_cube();
   EXPECT_TRUE(certified_valid(p, 0.99));

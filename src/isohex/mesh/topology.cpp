@@ -37,9 +37,12 @@ void for_each_face(const std::vector<FaceKey>& keys, F&& f) {
 // The three local faces (kHexFaces) at each corner of a hex.
 constexpr std::array<std::array<int, 3>, 8> kCornerFaces = [] {
   std::array<std::array<int, 3>, 8> cf{};
-  std::array<int, 8> n{};
+  std::array<std::size_t, 8> n{};
   for (int f = 0; f < 6; ++f)
-    for (int c : kHexFaces[static_cast<std::size_t>(f)]) cf[static_cast<std::size_t>(c)][static_cast<std::size_t>(n[static_cast<std::size_t>(c)]++)] = f;
+    for (int c : kHexFaces[static_cast<std::size_t>(f)]) {
+      const auto k = static_cast<std::size_t>(c);
+      cf[k][n[k]++] = f;
+    }
   return cf;
 }();
 

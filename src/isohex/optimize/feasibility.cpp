@@ -244,7 +244,7 @@ void ratio_coefficients(const std::array<Vec3, 8>& p, double weight, double norm
 
 namespace {
 
-// Bit k of kFrameCorners()[t]: frame t sees corner k (a non-zero coefficient). A table, not
+// Bit k of frame_corners()[t]: frame t sees corner k (a non-zero coefficient). A table, not
 // frame_coefficient() per corner: find_infeasible() asks it for every free vertex's frames.
 const std::array<std::uint8_t, kFrames>& frame_corners() {
   static const std::array<std::uint8_t, kFrames> mask = [] {

@@ -30,7 +30,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // |A|² and det A of four frames at once (A(r, c) = a[r + 3c] lane by lane), in the orders of
 // Eigen's squaredNorm() and determinant() for a 3×3 matrix: each lane the scalar bits.
 [[gnu::always_inline]] inline d4 squared_norms(const d4 (&a)[9]) {
-  return (((a[0] * a[0] + a[2] * a[2]) + (a[4] * a[4] + a[6] * a[6])) + ((a[1] * a[1] + a[3] * a[3]) + (a[5] * a[5] + a[7] * a[7]))) +
+  return (((a[0] * a[0] + a[2] * a[2]) + (a[4] * a[4] + a[6] * a[6])) +
+          ((a[1] * a[1] + a[3] * a[3]) + (a[5] * a[5] + a[7] * a[7]))) +
          a[8] * a[8];
 }
 [[gnu::always_inline]] inline d4 determinants(const d4 (&a)[9]) {

@@ -219,7 +219,7 @@ double hex_energy(const std::array<Vec3, 8>& p, Index h, double inv_len, const E
     // The shape objective's hex (every hex of the shape stage): its corner terms four at a
     // time, then the centre frame's constraint, as the loop below adds them.
     const double e = corner_shape_energy(p, inv_len);
-    return e + (frame(p, kCentreFrame, inv_len).determinant() > kMinFeasibleDet ? 0.0 : kInf);
+    return e + term_value(frame(p, kCentreFrame, inv_len), kCentreFrame, params, params.eps);
   }
   const double eps = params.eps_of(h);
   double e = hex_energy(p, inv_len, params, eps, params.frames_of(h));
@@ -278,9 +278,9 @@ struct HexFrames {
   bool bernstein;  // the hex also counts det J's Bernstein coefficients
 };
 
-}  // namespace
-
-namespace {
+// A frame's field in the batch (f: its first field; a block's lanes make the stride 4).
+[[gnu::always_inline]] inline double& field_of(double* f, int field) { return f[4 * field]; }
+[[gnu::always_inline]] inline double field_of(const double* f, int field) { return f[4 * field]; }
 
 // Appends to `batch` the frames of hex hf (corners p, the vertex at corner hf.k) that see the
 // vertex: the others' terms are constants of its place.
@@ -297,14 +297,15 @@ namespace {
     if (t < 8) {  // corner_frame()'s entries, written in place
       const auto& nb = kCornerNeighbors[static_cast<std::size_t>(t)];
       for (int col = 0; col < 3; ++col)
-        for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kA + r + 3 * col)] = (p[nb[col]][r] - p[t][r]) * hf.il;
+        for (int r = 0; r < 3; ++r) field_of(f, FrameBatch::kA + r + 3 * col) = (p[nb[col]][r] - p[t][r]) * hf.il;
     } else {
       const Mat3 A = t == kCentreFrame ? frame(p, t, hf.il) : interior[static_cast<std::size_t>(t - kFrames)];
-      for (int e = 0; e < 9; ++e) f[4 * (FrameBatch::kA + e)] = A.data()[e];
+      for (int e = 0; e < 9; ++e) field_of(f, FrameBatch::kA + e) = A.data()[e];
     }
-    for (int r = 0; r < 3; ++r) f[4 * (FrameBatch::kC + r)] = c[r];
-    f[4 * FrameBatch::kIl] = hf.il, f[4 * FrameBatch::kSq] = kCoefSq[t][k], f[4 * FrameBatch::kEps] = hf.eps;
-    f[4 * FrameBatch::kConstraint] = !untangle && t >= kCentreFrame;
+    for (int r = 0; r < 3; ++r) field_of(f, FrameBatch::kC + r) = c[r];
+    field_of(f, FrameBatch::kIl) = hf.il, field_of(f, FrameBatch::kSq) = kCoefSq[t][k];
+    field_of(f, FrameBatch::kEps) = hf.eps;
+    field_of(f, FrameBatch::kConstraint) = !untangle && t >= kCentreFrame;
   }
 }
 
@@ -317,13 +318,13 @@ struct Derivatives {
   double h[3][3] = {};
   // A frame's gradient and Hessian terms (f: its fields, four apart).
   void add(const double* f, bool hessian) {
-    for (int i = 0; i < 3; ++i) g[i] += f[4 * (FrameBatch::kGrad + i)];
+    for (int i = 0; i < 3; ++i) g[i] += field_of(f, FrameBatch::kGrad + i);
     if (!hessian) return;
-    const double id = f[4 * FrameBatch::kIdentity];
+    const double id = field_of(f, FrameBatch::kIdentity);
     int n = FrameBatch::kHessian;
     for (int c = 0; c < 3; ++c) {
       h[c][c] += id;
-      for (int r = c; r < 3; ++r) h[r][c] += f[4 * n++];
+      for (int r = c; r < 3; ++r) h[r][c] += field_of(f, n++);
     }
   }
   void store(Vec3* gp, Mat3* Hp) const {
@@ -380,15 +381,17 @@ double vertex_energy(const HexMesh& mesh, const Incidence& inc, const std::vecto
     for (std::size_t j = hf.first; j < hf.last; ++j) {
       const double* f = &batch.at(j, 0);
       // The shape stage's centre and interior frames only constrain: no derivatives.
-      const bool constraint = f[4 * FrameBatch::kConstraint] != 0;
-      const double D = f[4 * FrameBatch::kD];
-      e += constraint ? (D > kMinFeasibleDet ? 0.0 : kInf) : f[4 * FrameBatch::kValue];
+      const bool constraint = field_of(f, FrameBatch::kConstraint) != 0;
+      const double D = field_of(f, FrameBatch::kD);
+      e += constraint ? (D > kMinFeasibleDet ? 0.0 : kInf) : field_of(f, FrameBatch::kValue);
       if (!std::isfinite(e)) return kInf;
       if (!g) continue;
       if (model && bernstein)  // terms to interleave: copied one by one
-        model->push(f[4 * FrameBatch::kF], D, f[4 * FrameBatch::kCc], hf.eps,
-                    Vec3(f[4 * FrameBatch::kGF], f[4 * (FrameBatch::kGF + 1)], f[4 * (FrameBatch::kGF + 2)]),
-                    Vec3(f[4 * FrameBatch::kGD], f[4 * (FrameBatch::kGD + 1)], f[4 * (FrameBatch::kGD + 2)]),
+        model->push(field_of(f, FrameBatch::kF), D, field_of(f, FrameBatch::kCc), hf.eps,
+                    Vec3(field_of(f, FrameBatch::kGF), field_of(f, FrameBatch::kGF + 1),
+                         field_of(f, FrameBatch::kGF + 2)),
+                    Vec3(field_of(f, FrameBatch::kGD), field_of(f, FrameBatch::kGD + 1),
+                         field_of(f, FrameBatch::kGD + 2)),
                     constraint);
       if (!constraint) sums.add(f, H != nullptr);
     }

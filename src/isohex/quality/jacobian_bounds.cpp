@@ -9,14 +9,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <limits>
 #include <queue>
 #include <tuple>
@@ -25,25 +19,10 @@ namespace isohex {
 
 namespace {
 
-// x − x is 0 for a finite x and NaN otherwise: one pass over the 24 coordinates (every
-// certificate starts here).
 bool all_finite(const std::array<Vec3, 8>& p) {
-  static_assert(sizeof(p) == 24 * sizeof(double), "8 packed Vec3s");
-  const double* x = p[0].data();
-#if defined(__SSE2__)
-  __m128d acc = _mm_setzero_pd();
-  for (int i = 0; i < 24; i += 2) {
-    const __m128d v = _mm_loadu_pd(x + i);
-    acc = _mm_add_pd(acc, _mm_sub_pd(v, v));
-  }
-  double a[2];
-  _mm_storeu_pd(a, acc);
-  return a[0] + a[1] == 0;
-#else
-  double acc = 0;
-  for (int i = 0; i < 24; ++i) acc += x[i] - x[i];
-  return acc == 0;
-#endif
+  for (const Vec3& x : p)
+    if (!x.allFinite()) return false;
+  return true;
 }
 
 // GCC's vector extensions (AVX where the kernel's clone has it, SSE pairs otherwise); only
@@ -51,32 +30,19 @@ bool all_finite(const std::array<Vec3, 8>& p) {
 #pragma GCC diagnostic ignored "-Wpsabi"
 using d4 = double __attribute__((vector_size(32)));
 
-// The smallest and largest Bernstein coefficient and the smallest sample of a box, in one pass
-// (two lanes at a time: every certificate reads them). A non-finite value anywhere (an
-// overflow) makes min_s NaN: never certified.
+// The smallest and largest Bernstein coefficient and the smallest sample of a box. A
+// non-finite value anywhere (a non-finite corner, or an overflow) makes min_s NaN: never
+// certified, and a ratio bound of -1.
 struct Extremes {
   double min_b, max_b, min_s;
 };
 Extremes extremes(const std::array<double, 27>& b, const std::array<double, 27>& s) {
-  Extremes e{b[26], b[26], s[26]};
-  double sum = b[26] + s[26];
-#if defined(__SSE2__)
-  __m128d lo = _mm_set1_pd(b[26]), hi = lo, ls = _mm_set1_pd(s[26]), acc = _mm_setzero_pd();
-  for (int i = 0; i < 26; i += 2) {
-    const __m128d x = _mm_loadu_pd(b.data() + i), y = _mm_loadu_pd(s.data() + i);
-    lo = _mm_min_pd(x, lo), hi = _mm_max_pd(x, hi), ls = _mm_min_pd(y, ls);
-    acc = _mm_add_pd(acc, _mm_add_pd(x, y));
-  }
-  double l[2], h[2], m[2], a[2];
-  _mm_storeu_pd(l, lo), _mm_storeu_pd(h, hi), _mm_storeu_pd(m, ls), _mm_storeu_pd(a, acc);
-  e = {std::min(l[0], l[1]), std::max(h[0], h[1]), std::min(m[0], m[1])};
-  sum += a[0] + a[1];
-#else
-  for (int i = 0; i < 26; ++i) {
+  Extremes e{b[0], b[0], s[0]};
+  double sum = 0;
+  for (int i = 0; i < 27; ++i) {
     e.min_b = std::min(e.min_b, b[i]), e.max_b = std::max(e.max_b, b[i]), e.min_s = std::min(e.min_s, s[i]);
     sum += b[i] + s[i];
   }
-#endif
   if (!std::isfinite(sum)) e.min_s = std::numeric_limits<double>::quiet_NaN();
   if (e.min_b == 0) e.min_b = 0.0;  // +0 whichever zero came first: ratio_bound()'s sign
   return e;
@@ -122,13 +88,24 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
     for (int i = 0; i < 3; ++i) line(i + 3 * j, i + 3 * j + 9, i + 3 * j + 18);
 }
 
-// det J at the 27 lattice points, b[i + 3j + 9k] = xu[j + 3k] · (xv[i + 3k] × xw[i + 3j]),
-// from the operands laid out side by side (structure of arrays, U[c][n] the component c of
-// lane n), so that the compiler packs the 27 triple products into SIMD instructions; each is
-// Eigen's cross then dot, the same operations in the same order, so the same bits (tested).
-[[gnu::always_inline]] inline void triple_products(const double (&U)[3][28], const double (&V)[3][28],
-                                                   const double (&W)[3][28], double* out) {
-  alignas(64) double b[28];
+// det J at the 27 lattice points of a sub-box, b[i + 3j + 9k] = xu[j + 3k] · (xv[i + 3k] ×
+// xw[i + 3j]): the operands laid out side by side first (structure of arrays), so that the
+// compiler packs the 27 triple products into SIMD instructions; each is Eigen's cross then
+// dot, the same operations in the same order, so the same bits (tested).
+[[gnu::always_inline]] inline void lattice_dets_body(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv,
+                                                     const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
+  alignas(64) double U[3][28], V[3][28], W[3][28], b[28];
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        const int n = i + 3 * j + 9 * k;
+        for (int c = 0; c < 3; ++c) {
+          U[c][n] = xu[j + 3 * k][c];
+          V[c][n] = xv[i + 3 * k][c];
+          W[c][n] = xw[i + 3 * j][c];
+        }
+      }
+  for (int c = 0; c < 3; ++c) U[c][27] = V[c][27] = W[c][27] = 0;  // a 28th lane: whole vectors
   for (int n = 0; n < 28; ++n) {
     const double cx = V[1][n] * W[2][n] - V[2][n] * W[1][n];
     const double cy = V[2][n] * W[0][n] - V[0][n] * W[2][n];
@@ -136,33 +113,6 @@ double det_at(const std::array<Vec3, 8>& p, double u, double v, double w) {
     b[n] = U[0][n] * cx + U[1][n] * cy + U[2][n] * cz;
   }
   for (int n = 0; n < 27; ++n) out[n] = b[n];
-}
-
-// The lanes of lattice point n = i + 3j + 9k from per-component lattices xu[j + 3k] (at
-// (v_j, w_k)), xv[i + 3k] and xw[i + 3j]; a 28th lane of zeros makes whole vectors.
-[[gnu::always_inline]] inline void spread(int c, const double* xu, const double* xv, const double* xw,
-                                          double (&U)[3][28], double (&V)[3][28], double (&W)[3][28]) {
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) {
-        const int n = i + 3 * j + 9 * k;
-        U[c][n] = xu[j + 3 * k];
-        V[c][n] = xv[i + 3 * k];
-        W[c][n] = xw[i + 3 * j];
-      }
-  U[c][27] = V[c][27] = W[c][27] = 0;
-}
-
-// det J at the lattice of a sub-box, from its 9 edge vectors of each direction.
-[[gnu::always_inline]] inline void lattice_dets_body(const std::array<Vec3, 9>& xu, const std::array<Vec3, 9>& xv,
-                                                     const std::array<Vec3, 9>& xw, std::array<double, 27>& out) {
-  alignas(64) double U[3][28], V[3][28], W[3][28];
-  for (int c = 0; c < 3; ++c) {
-    double u[9], v[9], w[9];
-    for (int m = 0; m < 9; ++m) u[m] = xu[m][c], v[m] = xv[m][c], w[m] = xw[m][c];
-    spread(c, u, v, w, U, V, W);
-  }
-  triple_products(U, V, W, out.data());
 }
 
 // A bilinear blend of one component of the edge vectors a (at parameters 0, 0), b (1, 0),
@@ -449,6 +399,7 @@ bool certify(const std::array<Vec3, 8>& q, const Extremes& root, double floor, i
 
 // min / max of the element's coefficients (jacobian_ratio_bound()).
 double ratio_bound(const Extremes& e) {
+  if (std::isnan(e.min_s)) return -1.0;  // a non-finite corner
   if (!(e.max_b > 0)) return e.max_b == 0 && e.min_b == 0 ? 0.0 : -1.0;
   return std::max(-1.0, e.min_b / e.max_b);
 }
@@ -495,12 +446,7 @@ namespace {
 // coefficients; `ratio` (may be null) gets their ratio bound.
 bool certified_above(const std::array<Vec3, 8>& p, double floor, int max_subdivisions, double ratio_floor,
                      double* ratio = nullptr) {
-  // A non-finite corner is never valid (bernstein_box()'s whole-element path does not carry a
-  // NaN into every coefficient, and an infinite one would pass the floor).
-  if (!all_finite(p)) {
-    if (ratio) *ratio = -1;
-    return false;
-  }
+  // A non-finite corner is never valid: whole_element() makes its min_s NaN.
   const std::array<Vec3, 8> q = relative(p);
   const Extremes e = whole_element(q, nullptr, nullptr);
   const double rb = ratio_bound(e);
@@ -526,20 +472,15 @@ double certified_scaled_jacobian(const std::array<Vec3, 8>& p) {
 }
 
 double jacobian_ratio_bound(const std::array<Vec3, 8>& p) {
-  const Extremes e = whole_element(relative(p), nullptr, nullptr);
-  return std::isnan(e.min_s) ? -1.0 : ratio_bound(e);
+  return ratio_bound(whole_element(relative(p), nullptr, nullptr));
 }
 
 CertifiedQuality certified_quality(const std::array<Vec3, 8>& p) {
-  if (!all_finite(p)) {  // never certified (certified_above())
-    CertifiedQuality r{scaled_jacobian(p), -1};
-    if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0) r.scaled_jacobian = 0;
-    return r;
-  }
   const std::array<Vec3, 8> q = relative(p);
   const Extremes e = whole_element(q, nullptr, nullptr);
   CertifiedQuality r{scaled_jacobian(p), ratio_bound(e)};
-  if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0 && !certify(q, e, 0, kCertifySubdivisions)) r.scaled_jacobian = 0;
+  if (!is_degenerate(r.scaled_jacobian) && r.scaled_jacobian > 0 && !certify(q, e, 0, kCertifySubdivisions))
+    r.scaled_jacobian = 0;
   return r;
 }
 

@@ -230,34 +230,27 @@ void sj_range(const double* pts, const Hex* hexes, std::size_t begin, std::size_
 }
 #endif
 
-}  // namespace
-
-std::vector<double> scaled_jacobians(const HexMesh& mesh) {
-  const std::size_t n = mesh.hexes.size();
+// The batch kernel over hexes[0, n) of mesh's points, in parallel blocks.
+std::vector<double> scaled_jacobians_of(const HexMesh& mesh, const Hex* hexes, std::size_t n) {
   std::vector<double> out(n);
   if (n == 0) return out;
   const double* pts = mesh.points.empty() ? nullptr : mesh.points.front().data();
-  const Hex* hexes = mesh.hexes.data();
-  double* dst = out.data();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain),
-                    [=](const tbb::blocked_range<std::size_t>& r) {
-                      sj_range(pts, hexes, r.begin(), r.end(), dst);
-                    });
-  return out;
-}
-
-std::vector<double> scaled_jacobians(const HexMesh& mesh, const std::vector<Index>& ids) {
-  const std::size_t n = ids.size();
-  std::vector<double> out(n);
-  if (n == 0) return out;
-  std::vector<Hex> picked(n);  // the kernel reads hexes side by side
-  for (std::size_t i = 0; i < n; ++i) picked[i] = mesh.hexes[static_cast<std::size_t>(ids[i])];
-  const double* pts = mesh.points.empty() ? nullptr : mesh.points.front().data();
-  const Hex* hexes = picked.data();
   double* dst = out.data();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain),
                     [=](const tbb::blocked_range<std::size_t>& r) { sj_range(pts, hexes, r.begin(), r.end(), dst); });
   return out;
+}
+
+}  // namespace
+
+std::vector<double> scaled_jacobians(const HexMesh& mesh) {
+  return scaled_jacobians_of(mesh, mesh.hexes.data(), mesh.hexes.size());
+}
+
+std::vector<double> scaled_jacobians(const HexMesh& mesh, const std::vector<Index>& ids) {
+  std::vector<Hex> picked(ids.size());  // the kernel reads hexes side by side
+  for (std::size_t i = 0; i < ids.size(); ++i) picked[i] = mesh.hexes[static_cast<std::size_t>(ids[i])];
+  return scaled_jacobians_of(mesh, picked.data(), picked.size());
 }
 
 std::vector<double> hex_metric(const HexMesh& mesh, HexMetric m) {
