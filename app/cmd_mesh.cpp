@@ -63,6 +63,9 @@ struct Args {
   int refine_levels = 1;
   std::optional<double> feature_angle;
   double surface_band = 0.3;  ///< --surface-band, in cell sizes
+  std::string features = "round";  ///< --features
+  std::vector<std::string> cuts;  ///< --cut EXPR...
+  std::string keep = "both";      ///< --keep
   int* threads = nullptr;
 };
 
@@ -144,6 +147,33 @@ void run(const Args& a) {
     throw Error(fmt::format("{}: unknown mesh format (use {})", a.output, io::kMeshExtensions));
   const bool terminal = ::isatty(::fileno(stdout)) != 0;
   const auto start = Clock::now();
+  if (a.cuts.empty() && a.keep != "both") throw Error("--keep is only used with --cut");
+  if (a.features == "sheets") {
+    if (a.shape.empty()) throw Error("--features sheets meshes a --shape expression (a CSG solid), not a volume");
+    if (!a.cuts.empty()) throw Error("--features sheets already cuts along the shape's surfaces; add them to --shape");
+    std::vector<StageRow> rows;
+    std::size_t inverted_left = 0;
+    nlohmann::json j = mesh_shape_by_cuts(a.shape, a.cell_size, static_cast<int>(a.resolution), a.output,
+                                          !a.report.empty(), rows, inverted_left);
+    print_stage_table(rows);
+    j["input"] = a.shape;
+    j["stages"] = stage_table_json(rows);
+    j["peak_memory_mib"] = peak_memory_mib();
+    j["seconds"] = seconds_since(start);
+    if (!a.json.empty()) write_json(a.json, j);
+    if (!a.report.empty())
+      write_mesh_report(a.report, fmt::format("isohex mesh --features sheets: {}", a.shape), rows, j, io::read_mesh(a.output));
+    if (inverted_left > 0 || !j["valid"].get<bool>()) exit_code() = 1;
+    return;
+  }
+  std::vector<Shape> cut_shapes;  // parsed before any work: a bad expression costs nothing
+  for (std::size_t i = 0; i < a.cuts.size(); ++i) {
+    try {
+      cut_shapes.push_back(parse_shape(a.cuts[i]));
+    } catch (const Error& e) {
+      throw Error(fmt::format("--cut {} ('{}'): {}", i + 1, a.cuts[i], e.what()));
+    }
+  }
 
   contour::RegionSpec spec;
   spec.kind = *contour::region_from_name(a.region);
@@ -235,6 +265,13 @@ void run(const Args& a) {
     rows.push_back(stage_row("pillowing", out.mesh, seconds_since(t), keep_values));
     rows.back().extra = pillowing;
   }
+  nlohmann::json cutting;
+  CutStage cut;
+  if (!cut_shapes.empty()) {
+    t = Clock::now();
+    cutting = cut_stage(out.mesh, out.vertex_place, region, cut_shapes, *cut_keep_from_name(a.keep), terminal, cut);
+    rows.push_back(stage_row("cut", out.mesh, seconds_since(t), keep_values));
+  }
   release_free_memory();
   std::size_t inverted_left = 0;
   std::vector<std::uint8_t> released;  // vertices the optimisation released into the band
@@ -243,6 +280,7 @@ void run(const Args& a) {
     SlideSpec slide;
     if (slides)
       slide = {&region, &out.vertex_place, feature_angle, a.surface_band * r.grid.h};
+    if (!cut_shapes.empty()) slide.cut = &cut, slide.domain = &region.domain;
     optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide, &released);
     rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t), keep_values));
     rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
@@ -250,6 +288,23 @@ void run(const Args& a) {
                          {"worst moves", optimisation["worst"]["moves"]}};
   }
 
+  if (!cut_shapes.empty()) {
+    // Where the optimisation left the cut surfaces' vertices (each slid on its surface).
+    for (std::size_t j = 0; j < cut_shapes.size(); ++j) {
+      const contour::LevelSet& s = cut.surfaces[static_cast<std::size_t>(cut.first_cut) + j];
+      double far = 0;
+      std::size_t n = 0;
+      for (std::size_t v = 0; v < cut.constraints.size(); ++v) {
+        const BoundarySurface::Constraint& c = cut.constraints[v];
+        if (c.first != cut.first_cut + static_cast<int>(j) && c.second != cut.first_cut + static_cast<int>(j)) continue;
+        far = std::max(far, std::abs(s.level(out.mesh.points[v])) / s.scale());
+        ++n;
+      }
+      fmt::print("cut {}: {} vertices on it after the optimisation, within {:.3g} of it (relative to the mesh's size)\n",
+                 j + 1, n, far);
+      cutting["cuts"][j]["final_max_relative_distance"] = far;
+    }
+  }
   release_free_memory();
   t = Clock::now();
   const ValidationReport check = validate(out.mesh);
@@ -334,6 +389,7 @@ void run(const Args& a) {
     if (a.iso2) j["isovalue2"] = *a.iso2;
     j["grid"] = {r.grid.points[0], r.grid.points[1], r.grid.points[2]};
     j["cell_size"] = r.grid.h;
+    if (!cutting.is_null()) j["cutting"] = cutting;
     j["hexes"] = out.mesh.num_hexes();
     j["vertices"] = out.mesh.num_vertices();
     j["boundary_quads"] = check.num_boundary_quads;
@@ -429,7 +485,11 @@ void register_mesh(CLI::App& app) {
       "  isohex mesh head.nrrd --iso 1150 --cell-size 3.2 -o head.vtu --json head.json\n"
       "  isohex mesh cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 "
       "--cell-size 3 -o skin.inp\n"
-      "  isohex mesh --shape \"torus(0,0,0, 1,0.4)\" --resolution 40 -o torus.vtu");
+      "  isohex mesh --shape \"torus(0,0,0, 1,0.4)\" --resolution 40 -o torus.vtu\n"
+      "  isohex mesh cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 --cell-size 4 "
+      "--cut \"plane(0,110,0, 0,1,0)\" -o head.vtu   # the face cut off: two blocks\n"
+      "  isohex mesh --shape \"difference(box(0,0,0, 2,2,1), cylinder(1,1,-1, 1,1,2, 0.5))\" --features sheets "
+      "--cell-size 0.1 -o plate.vtu");
   cmd->add_option("volume", a->volume, "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)");
   cmd->add_option("--shape", a->shape, "Mesh an implicit shape expression instead (inside where its distance < ISO, default 0)");
   cmd->add_option("--iso", a->iso, "Isovalue");
@@ -493,6 +553,16 @@ void register_mesh(CLI::App& app) {
                   "their surface and optimise again (default 0.3; 0: every vertex stays on its surface); rounds that "
                   "leave a hex invalid run again in a band 5/3 as wide, and the better run is kept")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--features", a->features,
+                  "With --shape: round (default: the shape sampled and contoured, its edges rounded at the cell size) "
+                  "or sheets (a grid of its bounding box cut along each smooth piece of its primitives: every crease "
+                  "on a string of edges on the exact curve, every corner on its point)")
+      ->check(CLI::IsMember({"round", "sheets"}));
+  cmd->add_option("--cut", a->cuts,
+                  "After pillowing, cut the mesh along this shape expression's surface by sheet insertion (see 'isohex "
+                  "cut'): a string of edges on the crease where it meets the isosurface; repeat for successive cuts");
+  cmd->add_option("--keep", a->keep, "With --cut: both (default: the inside a new block), inside or outside")
+      ->check(CLI::IsMember({"both", "inside", "outside"}));
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
   cmd->add_option("--report", a->report,

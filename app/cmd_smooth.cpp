@@ -55,14 +55,6 @@ void print_quality(const char* label, const MetricSummary& s) {
              s.inverted, kQuestionableSJ, s.inverted + s.questionable + s.degenerate);
 }
 
-nlohmann::json quality_json(const MetricSummary& s) {
-  return {{"min", s.min},
-          {"mean", s.mean},
-          {"inverted", s.inverted},
-          {"below_0.2", s.inverted + s.questionable + s.degenerate},
-          {"degenerate", s.degenerate}};
-}
-
 void run(const Args& a) {
   ThreadLimit limit(*a.threads);
   const auto t0 = std::chrono::steady_clock::now();

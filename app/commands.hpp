@@ -9,6 +9,7 @@ namespace isohex::cli {
 
 void register_quality(CLI::App& app);
 void register_check(CLI::App& app);
+void register_cut(CLI::App& app);
 void register_convert(CLI::App& app);
 void register_generate(CLI::App& app);
 void register_mesh(CLI::App& app);
@@ -23,6 +24,7 @@ int& exit_code();
 }  // namespace isohex::cli
 
 #include "isohex/mesh/hex_mesh.hpp"
+#include "isohex/quality/summary.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -32,6 +34,10 @@ namespace isohex::cli {
 
 /// Reads a mesh for a command; prints how many non-hex cells were dropped, if any.
 HexMesh load_mesh(const std::string& file, bool skip_non_hex);
+
+/// Min, mean, inverted, below 0.2 and degenerate of a scaled-Jacobian summary (the reports of
+/// `isohex smooth` and `isohex cut`).
+nlohmann::json quality_json(const MetricSummary& s);
 
 /// Writes `json` (indented) to `file`, atomically.
 void write_json(const std::string& file, const nlohmann::json& json);

@@ -24,6 +24,14 @@ HexMesh load_mesh(const std::string& file, bool skip_non_hex) {
   return mesh;
 }
 
+nlohmann::json quality_json(const MetricSummary& s) {
+  return {{"min", s.min},
+          {"mean", s.mean},
+          {"inverted", s.inverted},
+          {"below_0.2", s.inverted + s.questionable + s.degenerate},
+          {"degenerate", s.degenerate}};
+}
+
 void write_json(const std::string& file, const nlohmann::json& json) {
   io::write_atomically(file, [&](std::ostream& os) { os << json.dump(2) << '\n'; });
 }

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   isohex::cli::register_quality(app);
   isohex::cli::register_check(app);
   isohex::cli::register_convert(app);
+  isohex::cli::register_cut(app);
   isohex::cli::register_generate(app);
   isohex::cli::register_mesh(app);
   isohex::cli::register_pillow(app);

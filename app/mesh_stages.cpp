@@ -48,6 +48,61 @@ nlohmann::json pillow_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_plac
   return j;
 }
 
+nlohmann::json cut_step_json(const CutStep& s, double max_distance) {
+  return {{"surface", s.surface},
+          {"missed", s.missed},
+          {"inside_hexes", s.inside_hexes},
+          {"outside_hexes", s.outside_hexes},
+          {"moved_across", s.moved_across},
+          {"sheet_hexes", s.sheet_hexes},
+          {"dropped_hexes", s.dropped_hexes},
+          {"surface_vertices", s.surface_vertices},
+          {"curve_vertices", s.curve_vertices},
+          {"corner_vertices", s.corner_vertices},
+          {"max_relative_distance", max_distance}};
+}
+
+nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const contour::Region& region,
+                         const std::vector<Shape>& shapes, CutKeep keep, bool terminal, CutStage& stage) {
+  if (terminal) fmt::print("  cutting...\n"), std::fflush(stdout);
+  CutOptions co;
+  co.keep = keep;
+  co.boundary = region.surfaces;
+  stage.first_cut = static_cast<int>(region.surfaces.size()) + 6;
+  for (const contour::LevelSet& f : contour::box_faces(region.domain)) co.boundary.push_back(f);
+  co.feature_degrees = 180;  // a scan's boundary has no features: its vertices are on level sets
+  CutResult r = cut(mesh, shapes, co);
+  nlohmann::json steps = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.steps.size(); ++i) {
+    const CutStep& c = r.steps[i];
+    fmt::print("cut {}: {}: {} hexes inside, {} outside; {} new sheet hexes{}; {} vertices on it ({} on curves, {} at "
+               "corners), within {:.3g} of it; optimised near the sheets: min SJ {:.4f}\n",
+               i + 1, c.surface, c.inside_hexes, c.outside_hexes, c.sheet_hexes,
+               c.dropped_hexes ? fmt::format(", {} dropped", c.dropped_hexes) : "", c.surface_vertices, c.curve_vertices,
+               c.corner_vertices, r.max_distance[i], c.optimisation.worst.min_sj_after);
+    steps.push_back(cut_step_json(c, r.max_distance[i]));
+    steps.back()["surface_quads"] = r.surface_quads[i].size();
+  }
+  // The places the later stages read: boundary vertices on a region surface or the box.
+  std::vector<std::uint8_t> on_boundary(r.mesh.points.size(), 0);
+  for (const Quad& q : boundary_quads(r.mesh))
+    for (Index v : q) on_boundary[v] = 1;
+  vertex_place.assign(r.mesh.points.size(), contour::kInteriorVertex);
+  for (std::size_t v = 0; v < vertex_place.size(); ++v) {
+    if (!on_boundary[v]) continue;
+    for (std::size_t k = 0; k < region.surfaces.size() && vertex_place[v] == contour::kInteriorVertex; ++k)
+      if (region.surfaces[k].on(r.mesh.points[v])) vertex_place[v] = static_cast<std::int8_t>(k);
+    if (vertex_place[v] == contour::kInteriorVertex && co.boundary.size() > region.surfaces.size())
+      for (std::size_t k = region.surfaces.size(); k < co.boundary.size(); ++k)
+        if (co.boundary[k].on(r.mesh.points[v])) vertex_place[v] = contour::kBoxVertex;
+  }
+  stage.before = std::move(mesh);
+  stage.surfaces = std::move(r.surfaces);
+  stage.constraints = std::move(r.constraints);
+  mesh = std::move(r.mesh);
+  return {{"keep", cut_keep_name(keep)}, {"cuts", steps}};
+}
+
 nlohmann::json refine_stage(const contour::Region& region, contour::ExtractResult& extracted, double tolerance,
                             int levels, bool terminal, double& seconds) {
   if (terminal) fmt::print("  boundary refinement...\n"), std::fflush(stdout);
@@ -400,7 +455,18 @@ nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& b
 nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide,
                               std::vector<std::uint8_t>* released_mask) {
   std::unique_ptr<BoundarySurface> surface;
-  if (slide.region) {
+  if (slide.cut) {
+    // With the boundary fixed, only the cut surfaces' vertices (and their curves) slide.
+    std::vector<BoundarySurface::Constraint> cons = slide.cut->constraints;
+    if (!slide.region)
+      for (BoundarySurface::Constraint& c : cons)
+        if (c.first != BoundarySurface::kNone && c.first < slide.cut->first_cut && c.second < slide.cut->first_cut)
+          c.pinned = true;
+    surface = std::make_unique<BoundarySurface>(mesh, slide.cut->before, slide.cut->surfaces, cons);
+    if (slide.domain) surface->set_domain(*slide.domain);
+    fmt::print("boundary: {} vertices slide (on the region's surfaces, the box and the cuts, and their curves); {} pinned\n",
+               surface->num_sliding(), surface->num_pinned());
+  } else if (slide.region) {
     std::vector<contour::LevelSet> surfaces = slide.region->surfaces;
     std::vector<std::int8_t> place = *slide.vertex_place;
     place.resize(mesh.points.size(), contour::kInteriorVertex);

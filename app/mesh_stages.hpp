@@ -6,7 +6,9 @@
 #include "isohex/contour/region.hpp"
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/optimize/optimize.hpp"
+#include "isohex/optimize/slide.hpp"
 #include "isohex/quality/summary.hpp"
+#include "isohex/sheets/cut.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -64,6 +66,25 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& options,
                               std::size_t* reattached = nullptr, bool* poor_left = nullptr);
 
+/// What `isohex mesh --cut` leaves for the optimisation: the mesh it cut (its boundary quads
+/// are the surface of vertices on no level set), the level sets (the region's surfaces, the
+/// domain box's faces, the cuts) and what each vertex keeps to among them.
+struct CutStage {
+  HexMesh before;
+  std::vector<contour::LevelSet> surfaces;
+  std::vector<BoundarySurface::Constraint> constraints;
+  int first_cut = 0;  ///< surfaces[first_cut + j] is cut j
+};
+/// The JSON facts of one cut (`isohex cut`, `isohex mesh --cut`, `--features sheets`);
+/// `max_distance`: CutResult::max_distance of its surface.
+nlohmann::json cut_step_json(const CutStep& step, double max_distance);
+
+/// Cuts `mesh` (after pillowing) by `shapes` (CutOptions: `keep`, the boundary on the region's
+/// surfaces and the domain box's faces); `vertex_place` is rebuilt for the cut mesh (a boundary
+/// vertex on a region surface or the box keeps that place; a vertex on a cut is interior to it).
+nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const contour::Region& region,
+                         const std::vector<Shape>& shapes, CutKeep keep, bool terminal, CutStage& stage);
+
 /// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
 /// (`--boundary slide`): each boundary vertex on its own surface, the one `vertex_place` names
 /// among region->surfaces. A vertex on one face of the domain box (an --outer box, or the
@@ -78,6 +99,10 @@ struct SlideSpec {
   /// below 0.2 after a first optimisation are released for a second one (`--surface-band`;
   /// 0: every sliding vertex stays on its surface).
   double band = 0;
+  /// After cuts (`isohex mesh --cut`): the boundary is the cut's level sets and constraints; with
+  /// `region` null (the boundary fixed) only the cut surfaces' vertices slide.
+  const CutStage* cut = nullptr;
+  const Aabb* domain = nullptr;  ///< the domain box, with `cut`
 };
 
 /// `isohex mesh`'s stage: run_optimisation() with the boundary fixed (or sliding, see SlideSpec)
@@ -86,6 +111,13 @@ struct SlideSpec {
 /// `released` (may be null) receives 1 for each vertex released into the band.
 nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverted_left, const SlideSpec& slide = {},
                               std::vector<std::uint8_t>* released = nullptr);
+
+/// `isohex mesh --shape EXPR --features sheets`: meshes the shape by cuts (sheets/csg_cuts.hpp)
+/// with hexes of `cell_size` (or `resolution` across), prints and writes it to `output`; one row
+/// in `rows`; `inverted_left` = inverted + degenerate hexes. Returns the JSON report.
+nlohmann::json mesh_shape_by_cuts(const std::string& expression, double cell_size, int resolution,
+                                  const std::string& output, bool keep_values, std::vector<StageRow>& rows,
+                                  std::size_t& inverted_left);
 
 /// Prints the table of rows (hexes, vertices, min/mean SJ, #<0, #<0.2, time).
 void print_stage_table(const std::vector<StageRow>& rows);

@@ -14,6 +14,9 @@ other end, *NODE PRINT of U); ccx must print "Job finished" and no *ERROR or *WA
   off, from below. The same 40 x 4 x 4 beam in metres (lengths x 1e-3), moved to negative
   coordinates below 0.01 in size, needs the writer's short spellings (".0123...", "1.2e-5")
   of its coordinates: its deflection must be the first one's x 1000 (to 1e-5).
+* Meshes of `isohex cut`: a 12^3 cube (side 2) carved by three overlapping spheres, and the
+  cube cut by a plane into two conforming blocks: clamped at z = 0, loaded sideways at z = 2;
+  det J > 0 at every Gauss point (numpy), ccx finishes, the top moves along the load.
 * Unless ISOHEX_CCX_PIPELINE=0: the meshes of `isohex mesh` on the headsq and
   MR head rows of scripts/paper_table.py (its case list), written as .inp: the main part's
   bottom (z within 1 % of its height above its lowest node) clamped, a sideways load on its
@@ -277,6 +280,37 @@ def test_pipeline(cli, ccx, data, tmp):
             check(len(u) == len(top) and sum(v[0] for v in u.values()) > 0, f"{name}: the loaded top moves along the load")
 
 
+# ---- meshes cut by sheet insertion ---------------------------------------------------------
+
+def test_cut(cli, ccx, tmp):
+    """`isohex cut` meshes: a cube carved by three overlapping spheres, and the cube cut by a
+    plane into two conforming blocks, clamped at z = 0 and loaded sideways on z = 2."""
+    cube = os.path.join(tmp, "cut_cube.vtu")
+    rc, out = run([cli, "generate", "box", "-n", "12", "--size", "2", "-o", cube])
+    check(rc == 0, f"generate: {out}")
+    cases = {"cube carved by three spheres": ["--keep", "outside", "--surface", "sphere(2,2,2,1.2)",
+                                             "--surface", "sphere(2,0.8,1.0,0.75)", "--surface", "sphere(1.0,2,1.5,0.7)"],
+             "cube cut by a plane, both blocks": ["--surface", "plane(1,1,1, 1,0.3,0.2)"]}
+    for name, args in cases.items():
+        work = os.path.join(tmp, re.sub(r"[^a-z0-9]+", "_", name.lower()).strip("_"))
+        os.makedirs(work, exist_ok=True)
+        inp = os.path.join(work, "mesh.inp")
+        rc, out = run([cli, "cut", cube, "-o", inp] + args)
+        if not check(rc == 0, f"{name}: isohex cut exit {rc}: {out[-600:]}"):
+            continue
+        nodes, elements = read_inp(inp)
+        check(len(components(nodes, elements)) == 1, f"{name}: one connected part")
+        clamped = [n for n, p in nodes.items() if p[2] == 0.0]
+        top = [n for n, p in nodes.items() if p[2] == 2.0]
+        out, u = solve(ccx, work, inp, clamped, {n: (1, 1.0 / len(top)) for n in top}, top)
+        _, at_gauss, _ = gauss_point_jacobians(nodes, elements)
+        check(at_gauss.min() > 0, f"{name}: det J > 0 at every Gauss point (numpy)")
+        print(f"{name}: {len(elements)} elements, {len(clamped)} nodes clamped, {len(top)} loaded; ccx: "
+              + ("Job finished" if "Job finished" in out else out[-400:]))
+        if accepted(out, name):
+            check(len(u) == len(top) and sum(v[0] for v in u.values()) > 0, f"{name}: the loaded top moves along the load")
+
+
 def main():
     args = oracle_args(__doc__.split("\n")[0], lambda ap: ap.add_argument(
         "--no-pipeline", action="store_true", help="the beam only (or ISOHEX_CCX_PIPELINE=0)"))
@@ -285,6 +319,7 @@ def main():
         print("SKIP: ccx is not installed (scripts/install-deps.sh installs calculix-ccx)")
         return 77
     test_beam(args.cli, ccx, args.tmp)
+    test_cut(args.cli, ccx, args.tmp)
     if not args.no_pipeline and os.environ.get("ISOHEX_CCX_PIPELINE") != "0":
         if os.path.isdir(os.path.join(args.data, "volumes")):
             test_pipeline(args.cli, ccx, args.data, args.tmp)

@@ -27,6 +27,12 @@ LevelSet::LevelSet(const Aabb& box, int face) : face_(face), box_(box) {
   tolerance_ = 1e-10 * scale_;
 }
 
+LevelSet::LevelSet(std::shared_ptr<const Shape> shape, double scale) : shape_(std::move(shape)) {
+  if (!shape_ || !(scale > 0) || !std::isfinite(scale)) throw Error("LevelSet: a shape needs a positive, finite scale");
+  scale_ = scale;
+  tolerance_ = 1e-10 * scale;
+}
+
 namespace {
 // A box face's inward unit normal: +e_a on the lower side, −e_a on the upper.
 Vec3 face_normal(int face) {
@@ -38,6 +44,7 @@ Vec3 face_normal(int face) {
 
 double LevelSet::level(const Vec3& p) const {
   if (face_ >= 0) return face_ % 2 ? box_.hi[face_ / 2] - p[face_ / 2] : p[face_ / 2] - box_.lo[face_ / 2];
+  if (shape_) return -evaluate(*shape_, p);
   if (!field_) return radius_ - (p - center_).norm();
   if (snap_to_grid_) {
     const Volume& v = field_->volume();
@@ -56,6 +63,17 @@ double LevelSet::level(const Vec3& p, Vec3& gradient) const {
     gradient = face_normal(face_);
     return level(p);
   }
+  if (shape_) {
+    // Central differences: the distance is piecewise smooth, and a step of 1e-7 of the scale
+    // keeps both the truncation and the rounding error near 1e-9 of the gradient.
+    const double h = 1e-7 * scale_;
+    for (int j = 0; j < 3; ++j) {
+      Vec3 a = p, b = p;
+      a[j] += h, b[j] -= h;
+      gradient[j] = (level(a) - level(b)) / (2 * h);
+    }
+    return level(p);
+  }
   if (!field_) {
     const Vec3 d = p - center_;
     const double n = d.norm();
@@ -70,6 +88,15 @@ Vec3 LevelSet::root(const Vec3& a, const Vec3& b) const {
   if (std::abs(level(b)) <= tolerance_) return b;
   if (std::abs(level(a)) <= tolerance_) return a;
   if (field_) return field_->root_on_segment(a, b, tolerance_);
+  if (shape_) {
+    Vec3 lo = a, hi = b;  // L(lo) > 0 >= L(hi)
+    for (int it = 0; it < 200 && std::abs(level(hi)) > tolerance_; ++it) {
+      const Vec3 mid = 0.5 * (lo + hi);
+      (level(mid) > 0 ? lo : hi) = mid;
+      if ((hi - lo).norm() <= 1e-12 * (b - a).norm()) break;
+    }
+    return hi;
+  }
   if (face_ >= 0) {
     const double la = level(a), lb = level(b);
     return a + std::clamp(la / (la - lb), 0.0, 1.0) * (b - a);
@@ -116,6 +143,7 @@ bool LevelSet::project(Vec3& p, double max_distance) const {
   }
   if (std::abs(level(p)) <= tolerance_) return true;
   if (field_) return field_->project(p, max_distance, tolerance_);
+  if (shape_) return project_shape(p, max_distance);
   const Vec3 d = p - center_;
   const double n = d.norm();
   if (n == 0 || std::abs(n - radius_) > max_distance) return false;
@@ -123,7 +151,31 @@ bool LevelSet::project(Vec3& p, double max_distance) const {
   return true;
 }
 
+bool LevelSet::project_shape(Vec3& p, double max_distance) const {
+  // Newton steps along the gradient (one step for a plane or a sphere: L is a distance); a
+  // step that overshoots a kink of a CSG distance is halved until |L| falls.
+  Vec3 q = p;
+  for (int it = 0; it < 60; ++it) {
+    Vec3 g;
+    const double l = level(q, g);
+    if (std::abs(l) <= tolerance_) {
+      if (!((q - p).norm() <= max_distance)) return false;
+      p = q;
+      return true;
+    }
+    const double gg = g.squaredNorm();
+    if (!(gg > 0)) return false;
+    Vec3 step = (l / gg) * g;
+    Vec3 next = q - step;
+    for (int half = 0; half < 30 && !(std::abs(level(next)) < std::abs(l)); ++half) next = q - (step *= 0.5);
+    q = next;
+    if (!((q - p).norm() <= 2 * max_distance)) return false;
+  }
+  return false;
+}
+
 std::string LevelSet::describe() const {
+  if (shape_) return fmt::format("shape {}", to_shape_string(*shape_));
   if (face_ >= 0)
     return fmt::format("box face {} = {:g}", "xyz"[face_ / 2], face_ % 2 ? box_.hi[face_ / 2] : box_.lo[face_ / 2]);
   if (!field_) return fmt::format("sphere ({:g}, {:g}, {:g}) radius {:g}", center_.x(), center_.y(), center_.z(), radius_);

@@ -34,6 +34,10 @@ class LevelSet {
   /// distance to its plane, positive towards the box; project() only succeeds within the face
   /// (its edges included), so a point never slides off it onto a neighbouring face.
   LevelSet(const Aabb& box, int face);
+  /// The surface of an implicit shape (implicit.hpp), positive inside: L = −evaluate(shape, p),
+  /// a signed distance (exact for a primitive, a bound near CSG creases). `scale` is the unit
+  /// of relative distances (e.g. the size of the mesh it cuts); the tolerance is 1e-10 of it.
+  LevelSet(std::shared_ptr<const Shape> shape, double scale);
 
   /// L(p). For an isosurface whose interpolant is exact at grid points (trilinear, cubic),
   /// a point within 1e-9 cells of a grid point takes the stored value exactly, so that
@@ -64,11 +68,16 @@ class LevelSet {
   bool project_on_face(Vec3& p, double max_distance, const LevelSet& plane) const;
   /// The isosurface's field, or null for a sphere or a box face.
   [[nodiscard]] const IsoField* field() const { return field_.get(); }
-  /// "isosurface 1150 (inside above)", "sphere (...) radius R" or "box face z = 0".
+  /// The implicit shape, or null for the others.
+  [[nodiscard]] const Shape* shape() const { return shape_.get(); }
+  /// "isosurface 1150 (inside above)", "sphere (...) radius R", "box face z = 0" or "shape EXPR".
   [[nodiscard]] std::string describe() const;
 
  private:
+  bool project_shape(Vec3& p, double max_distance) const;
+
   std::shared_ptr<const IsoField> field_;
+  std::shared_ptr<const Shape> shape_;
   bool snap_to_grid_ = false;
   Vec3 center_{0, 0, 0};
   double radius_ = 0;

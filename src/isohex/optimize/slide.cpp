@@ -1,7 +1,10 @@
 // The original boundary surface, its feature edges, and nearest-point projection onto it.
 #include "isohex/optimize/slide.hpp"
 
+#include "isohex/error.hpp"
 #include "isohex/mesh/topology.hpp"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -57,6 +60,75 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, std::vector<contour::Level
   assign_targets(mesh, place, pin);
 }
 
+BoundarySurface::BoundarySurface(const HexMesh& mesh, const HexMesh& triangles_of, std::vector<contour::LevelSet> surfaces,
+                                 const std::vector<Constraint>& constraints)
+    : surfaces_(std::move(surfaces)) {
+  classify(triangles_of, 180.0, true);  // the triangles; the roles are the constraints'
+  const std::size_t n = constraints.size();
+  role_.assign(n, static_cast<std::uint8_t>(Role::interior));
+  target_.assign(n, -1);
+  face_.assign(n, -1);
+  second_.assign(n, kNone);
+  facing_.assign(n, Vec3::Zero());
+  const auto valid = [&](std::int8_t k) {
+    return k == kNone || (k == kTriangles && !tris_.empty()) || (k >= 0 && static_cast<std::size_t>(k) < surfaces_.size());
+  };
+  for (std::size_t v = 0; v < n; ++v) {
+    Constraint c = constraints[v];
+    if (!valid(c.first) || !valid(c.second) || (c.first == kNone && c.second != kNone) || (c.first == c.second && c.first != kNone))
+      throw Error(fmt::format("BoundarySurface: vertex {} has an invalid constraint ({}, {})", v, c.first, c.second));
+    if (c.first == kTriangles && c.second >= 0) std::swap(c.first, c.second);  // step in the level set's plane
+    if (c.pinned) {
+      role_[v] = static_cast<std::uint8_t>(Role::pinned);
+    } else if (c.first != kNone) {
+      role_[v] = static_cast<std::uint8_t>(Role::slides);
+      target_[v] = c.first >= 0 ? c.first : -1;
+      second_[v] = c.second;
+      if (c.second == kTriangles && v < mesh.points.size()) project(mesh.points[v], nullptr, &facing_[v]);
+    }
+  }
+  sliding_ = pinned_ = 0;
+  for (std::uint8_t r : role_) {
+    sliding_ += r == static_cast<std::uint8_t>(Role::slides);
+    pinned_ += r == static_cast<std::uint8_t>(Role::pinned);
+  }
+}
+
+bool BoundarySurface::project_on_curve(Index v, Vec3& x, double len) const {
+  // Gauss–Newton on the two levels: the least step that zeroes both linearisations. The
+  // triangles' level is the signed distance to the plane of the nearest triangle facing the
+  // vertex's side, found again at every step.
+  const contour::LevelSet& a = surfaces_[static_cast<std::size_t>(target(v))];
+  const int b = second(v);
+  const double tri_tol = 1e-10 * (hi_ - lo_).norm();
+  Vec3 q = x;
+  for (int it = 0; it < 60; ++it) {
+    Vec3 ga, gb;
+    const double ra = a.level(q, ga);
+    double rb = 0, tol_b = 0;
+    if (b == kTriangles) {
+      const Vec3 foot = project(q, &facing_[v], &gb);
+      rb = gb.dot(q - foot);
+      tol_b = tri_tol;
+    } else {
+      const contour::LevelSet& s = surfaces_[static_cast<std::size_t>(b)];
+      rb = s.level(q, gb);
+      tol_b = s.tolerance();
+    }
+    if (std::abs(ra) <= a.tolerance() && std::abs(rb) <= tol_b) {
+      if (!((q - x).norm() <= len)) return false;
+      x = q;
+      return true;
+    }
+    const double aa = ga.dot(ga), ab = ga.dot(gb), bb = gb.dot(gb), det = aa * bb - ab * ab;
+    if (!(det > 1e-12 * aa * bb)) return false;  // tangent surfaces: no curve to keep to
+    const double la = (bb * ra - ab * rb) / det, lb = (aa * rb - ab * ra) / det;
+    q -= la * ga + lb * gb;
+    if (!q.allFinite() || !((q - x).norm() <= 2 * len)) return false;
+  }
+  return false;
+}
+
 void BoundarySurface::assign_targets(const HexMesh& mesh, const std::vector<std::int8_t>& place,
                                      const std::vector<std::uint8_t>* pin) {
   // A vertex slides only on its own surface, and only when it is on it and on no other: where
@@ -103,7 +175,7 @@ std::size_t BoundarySurface::num_sliding_on(std::size_t k) const {
 }
 
 bool BoundarySurface::tangent_normal(Index v, const Vec3& x, Vec3& n) const {
-  if (surfaces_.empty()) {
+  if (on_triangles(v)) {
     n = Vec3::Zero();
     project(x, nullptr, &n);
     return true;
@@ -118,11 +190,12 @@ bool BoundarySurface::tangent_normal(Index v, const Vec3& x, Vec3& n) const {
 }
 
 bool BoundarySurface::reproject(Index v, Vec3& x, const Vec3& n, double len) const {
-  if (surfaces_.empty()) {
+  if (on_triangles(v)) {
     x = project(x, &n);
     return true;
   }
   if (target(v) < 0) return false;
+  if (second(v) != kNone) return project_on_curve(v, x, len);
   Vec3 p = x;
   const contour::LevelSet& s = surfaces_[target(v)];
   if (!(on_face(v) >= 0 ? s.project_on_face(p, len, surfaces_[on_face(v)]) : s.project(p, len))) return false;
@@ -140,12 +213,17 @@ bool BoundarySurface::in_domain(const Vec3& x) const {
 
 std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band) {
   std::size_t n = 0;
+  // Exact surfaces stay exact: a vertex on a shape (a cut), or on its curve with another
+  // surface, is not released, nor a corner where constraints pinned it.
+  const auto on_shape = [&](int k) { return k >= 0 && surfaces_[static_cast<std::size_t>(k)].shape() != nullptr; };
   for (Index v : vertices) {
     if (v < 0 || static_cast<std::size_t>(v) >= role_.size()) continue;
+    if (on_shape(target(v)) || on_shape(second(v))) continue;
+    if (role_[v] == static_cast<std::uint8_t>(Role::pinned) && !second_.empty()) continue;
     if (role_[v] == static_cast<std::uint8_t>(Role::pinned)) {
       // On the input's own triangles, a feature vertex is released about them; on level sets a
       // rim vertex about the first isosurface it is on (box faces and spheres are exact).
-      if (!surfaces_.empty()) {
+      if (!on_triangles(v)) {
         std::size_t k = 0;
         while (k < surfaces_.size() && !(surfaces_[k].field() && surfaces_[k].on(mesh.points[v]))) ++k;
         if (k == surfaces_.size()) continue;
@@ -168,11 +246,11 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
 }
 
 bool BoundarySurface::snap(Index v, Vec3& x, double len) const {
-  if (surfaces_.empty()) {
+  if (on_triangles(v)) {
     x = project(x);
     return true;
   }
-  if (on_face(v) >= 0) return reproject(v, x, Vec3::Zero(), len);
+  if (on_face(v) >= 0 || second(v) != kNone) return reproject(v, x, Vec3::Zero(), len);
   Vec3 foot;
   if (!foot_point(v, x, kFootReach * band_, foot) || !in_domain(foot)) return false;
   x = foot;
@@ -188,7 +266,7 @@ bool BoundarySurface::reattach(Index v) {
 }
 
 bool BoundarySurface::foot_point(Index v, const Vec3& x, double max_reach, Vec3& foot) const {
-  if (surfaces_.empty()) {
+  if (on_triangles(v)) {
     foot = project(x);
     return true;
   }
@@ -245,7 +323,7 @@ BoundarySurface::Fit BoundarySurface::fit(const HexMesh& mesh) const {
 }
 
 double BoundarySurface::offset(Index v, const Vec3& x) const {
-  if (surfaces_.empty()) return (project(x) - x).norm();
+  if (on_triangles(v)) return (project(x) - x).norm();
   if (target(v) < 0) return 0;
   Vec3 foot;
   if (foot_point(v, x, kFootReach * band_, foot)) return (foot - x).norm();
@@ -256,7 +334,7 @@ double BoundarySurface::offset(Index v, const Vec3& x) const {
 }
 
 double BoundarySurface::deviation(Index v, const Vec3& x) const {
-  if (surfaces_.empty()) return (project(x) - x).norm();
+  if (on_triangles(v)) return (project(x) - x).norm();
   if (target(v) < 0) return 0;
   const contour::LevelSet& s = surfaces_[target(v)];
   return std::abs(s.level(x)) / s.scale();

@@ -51,6 +51,22 @@ class BoundarySurface {
   BoundarySurface(const HexMesh& mesh, std::vector<contour::LevelSet> surfaces, const std::vector<std::int8_t>& place,
                   double feature_degrees = 30.0, const std::vector<std::uint8_t>* pin = nullptr);
 
+  /// What a vertex keeps to when the places are given one by one (the cut meshes of
+  /// sheets/cut.hpp): nothing (kNone: an interior vertex), the triangles of a mesh's boundary
+  /// (kTriangles), or surfaces()[k]; with `second` too, the curve where the two meet.
+  static constexpr std::int8_t kNone = -1, kTriangles = -2;
+  struct Constraint {
+    std::int8_t first = kNone, second = kNone;
+    bool pinned = false;  ///< held where it is (where three surfaces meet, a feature of the triangles)
+  };
+  /// Sliding by `constraints` (one per vertex of `mesh`, the mesh to optimise), with the boundary quads
+  /// of `triangles_of` (e.g. the mesh before it was cut) as the kTriangles surface. A vertex
+  /// with a constraint slides even if it is inside the mesh (a cut surface between two
+  /// blocks). Steps along a curve are put back on both surfaces at once (Newton steps on the
+  /// two levels, the triangles' by the plane of the nearest one facing the vertex's side).
+  BoundarySurface(const HexMesh& mesh, const HexMesh& triangles_of, std::vector<contour::LevelSet> surfaces,
+                  const std::vector<Constraint>& constraints);
+
   /// The level sets vertices slide on (empty when sliding on the original boundary triangles).
   [[nodiscard]] const std::vector<contour::LevelSet>& surfaces() const { return surfaces_; }
   /// The index into surfaces() of sliding vertex v's target, or −1 (not sliding, or triangles).
@@ -58,6 +74,9 @@ class BoundarySurface {
   /// The box face (an index into surfaces()) whose plane sliding vertex v also keeps to: a
   /// rim vertex slides along the curve where its target meets that plane. −1 for the others.
   [[nodiscard]] int on_face(Index v) const { return v < static_cast<Index>(face_.size()) ? face_[v] : -1; }
+  /// The second surface a vertex placed by a Constraint keeps to (kNone, kTriangles or an index
+  /// into surfaces()).
+  [[nodiscard]] int second(Index v) const { return v < static_cast<Index>(second_.size()) ? second_[v] : kNone; }
   /// How many vertices slide on surfaces()[k].
   [[nodiscard]] std::size_t num_sliding_on(std::size_t k) const;
   /// The unit normal of v's target surface at (or, for the triangles, nearest to) x, in `n`;
@@ -77,7 +96,8 @@ class BoundarySurface {
   /// one voxel thick, whose quads face opposite ways at a vertex. Returns how many were released.
   /// Pinned vertices are released too where they have a surface to keep near: about the
   /// input's triangles (feature vertices), or about the isosurface they lie on (a rim, where it
-  /// meets the domain box).
+  /// meets the domain box). Not released: vertices on a shape (a cut surface) or on its curve
+  /// with another surface, and the pinned ones of the Constraint form (corners).
   std::size_t loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band);
   /// Where loose vertex v at x would sit on its target (`len`: the local edge length): the
   /// nearest triangle point, a rim vertex's point on its curve, else its foot point on its
@@ -147,6 +167,10 @@ class BoundarySurface {
   [[nodiscard]] const std::vector<std::array<Vec3, 3>>& triangles() const { return tris_; }
 
  private:
+  /// v slides on (or is released about) the triangles: the triangle form, or a Constraint's.
+  [[nodiscard]] bool on_triangles(Index v) const { return !tris_.empty() && target(v) < 0; }
+  /// x onto the curve of v's two constraints (Newton steps within `len`); false if it fails.
+  bool project_on_curve(Index v, Vec3& x, double len) const;
   void classify(const HexMesh& mesh, double feature_degrees, bool keep_triangles);
   /// v's foot point on its target from x: projections of growing reach (band_, doubled, up to
   /// max_reach); false if none succeeds.
@@ -158,6 +182,8 @@ class BoundarySurface {
   std::vector<contour::LevelSet> surfaces_;
   std::vector<std::int8_t> target_;  // per vertex: index into surfaces_, −1 unless sliding on one
   std::vector<std::int8_t> face_;    // per vertex: the box face a rim vertex keeps to, or −1
+  std::vector<std::int8_t> second_;  // per vertex (or empty): a Constraint's second surface
+  std::vector<Vec3> facing_;         // per vertex (or empty): the side of the triangles it keeps to
   std::vector<std::uint8_t> unpinned_;  // per vertex (or empty): loosen() released it from pinned
   std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
   double band_ = 0;

@@ -1,0 +1,129 @@
+// isohex cut IN -o OUT --surface EXPR...: cut a hex mesh along implicit surfaces by sheet
+// insertion (§4.2), keeping both sides as blocks or one side.
+#include "commands.hpp"
+#include "mesh_stages.hpp"
+
+#include "isohex/error.hpp"
+#include "isohex/io/mesh_io.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/summary.hpp"
+#include "isohex/sheets/cut.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <memory>
+
+namespace isohex::cli {
+
+namespace {
+
+struct Args {
+  std::string input, output, json, keep = "both";
+  std::vector<std::string> surfaces;
+  double offset = CutOptions{}.offset, feature_angle = CutOptions{}.feature_degrees;
+  int rings = CutOptions{}.rings;
+  bool no_optimize = false, skip_non_hex = false;
+  int* threads = nullptr;
+};
+
+void run(const Args& a) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ThreadLimit limit(*a.threads);
+  std::vector<Shape> shapes;
+  for (std::size_t i = 0; i < a.surfaces.size(); ++i) {
+    try {
+      shapes.push_back(parse_shape(a.surfaces[i]));
+    } catch (const Error& e) {
+      throw Error(fmt::format("cut: --surface {} ('{}'): {}", i + 1, a.surfaces[i], e.what()));
+    }
+  }
+  if (!io::is_known_mesh_extension(a.output))
+    throw Error(fmt::format("cut: {}: unknown mesh format (known: {})", a.output, io::kMeshExtensions));
+  const HexMesh mesh = load_mesh(a.input, a.skip_non_hex);
+  CutOptions opt;
+  opt.keep = *cut_keep_from_name(a.keep);
+  opt.offset = a.offset;
+  opt.feature_degrees = a.feature_angle;
+  opt.rings = a.rings;
+  opt.optimize = !a.no_optimize;
+  fmt::print("{}: {} hexes, {} vertices; {} cut(s), keep {}\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
+             shapes.size(), a.keep);
+  const CutResult r = cut(mesh, shapes, opt);
+
+  nlohmann::json report;
+  report["input"] = a.input;
+  report["output"] = a.output;
+  report["keep"] = a.keep;
+  nlohmann::json steps = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.steps.size(); ++i) {
+    const CutStep& s = r.steps[i];
+    fmt::print("cut {}: {}: {} hexes inside, {} outside ({} moved across); {} new sheet hexes{}; {} vertices on the "
+               "surface ({} on curves, {} at corners){}\n",
+               i + 1, s.surface, s.inside_hexes, s.outside_hexes, s.moved_across, s.sheet_hexes,
+               s.dropped_hexes ? fmt::format(", {} dropped", s.dropped_hexes) : "", s.surface_vertices,
+               s.curve_vertices, s.corner_vertices, s.unplaced ? fmt::format("; {} not placed", s.unplaced) : "");
+    if (s.optimized)
+      fmt::print("  optimised near the sheets: untangle {:.4f} ({} inverted), shape {} sweeps, worst {:.4f} -> {:.4f}\n",
+                 s.optimisation.untangle.min_sj, s.optimisation.untangle.inverted, s.optimisation.shape.iterations,
+                 s.optimisation.worst.min_sj_before, s.optimisation.worst.min_sj_after);
+    steps.push_back(cut_step_json(s, r.max_distance[i]));
+    steps.back()["surface_quads"] = r.surface_quads[i].size();
+  }
+  report["cuts"] = steps;
+  const MetricSummary q = summarize(HexMetric::scaled_jacobian, scaled_jacobians(r.mesh), 5);
+  const ValiditySummary validity = summarize_validity(r.mesh);
+  fmt::print("result: {} hexes, {} vertices\n", r.mesh.num_hexes(), r.mesh.num_vertices());
+  fmt::print("scaled Jacobian: min {:.4f}  mean {:.4f}  inverted (< 0): {}  below {}: {}\n", q.min, q.mean, q.inverted,
+             kQuestionableSJ, q.inverted + q.questionable + q.degenerate);
+  fmt::print("{}\n", describe(validity));
+  for (std::size_t i = 0; i < r.max_distance.size(); ++i)
+    fmt::print("cut {}: {} quads on the surface, vertices within {:.3g} of it (relative to the mesh's diagonal)\n",
+               i + 1, r.surface_quads[i].size(), r.max_distance[i]);
+  report["quality"] = quality_json(q);
+  report["validity"] = to_json(validity);
+  report["hexes"] = r.mesh.num_hexes();
+  report["vertices"] = r.mesh.num_vertices();
+  report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  io::write_mesh(a.output, r.mesh);
+  fmt::print("wrote {}\n", a.output);
+  if (!a.json.empty()) write_json(a.json, report);
+  if (q.inverted + q.degenerate > 0) exit_code() = 1;
+}
+
+}  // namespace
+
+void register_cut(CLI::App& app) {
+  auto a = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("cut", "Cut a hex mesh along implicit surfaces by sheet insertion (sharp creases, "
+                                            "Boolean-like cuts)");
+  cmd->footer(
+      "Examples:\n"
+      "  isohex generate box -o cube.vtu -n 12 --size 2\n"
+      "  isohex cut cube.vtu -o carved.vtu --surface \"sphere(1,1,1, 0.6)\" --keep outside\n"
+      "  isohex cut cube.vtu -o two.vtu --surface \"plane(0.5,0.5,0.5, 1,0.3,0.2)\"   # two blocks, conforming\n"
+      "  isohex cut cube.vtu -o c.vtu --surface \"sphere(1,1,1,0.6)\" --surface \"sphere(0,0,1,0.5)\" --keep outside");
+  cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp .msh .exo)")->required();
+  cmd->add_option("-o,--output", a->output, "The cut mesh")->required();
+  cmd->add_option("--surface", a->surfaces,
+                  "A cut surface as a shape expression (see 'isohex volume shape --help'); its inside is the shape's. "
+                  "Repeat for successive cuts")
+      ->required();
+  cmd->add_option("--keep", a->keep,
+                  "both (default: the inside becomes a new block, the cut a conforming interface), inside or outside")
+      ->check(CLI::IsMember({"both", "inside", "outside"}));
+  cmd->add_option("--offset", a->offset, "Thickness of each new sheet / local edge length, in (0, 1) (default 0.25)");
+  cmd->add_option("--feature-angle", a->feature_angle,
+                  "Boundary edges bent by more than this many degrees are features of the input (default 30)")
+      ->check(CLI::Range(0.0, 180.0));
+  cmd->add_option("--rings", a->rings, "Optimise the vertices within this many hex rings of the new sheets (default 3)")
+      ->check(CLI::Range(0, 1000));
+  cmd->add_flag("--no-optimize", a->no_optimize, "Place the new sheets on the surfaces but do not optimise");
+  cmd->add_option("--json", a->json, "Write a JSON report");
+  cmd->add_flag("--skip-non-hex", a->skip_non_hex, "Drop non-hexahedral cells instead of failing");
+  a->threads = add_threads_option(cmd);
+  cmd->callback([a] { run(*a); });
+}
+
+}  // namespace isohex::cli

@@ -1,0 +1,544 @@
+// Cutting a hex mesh along implicit surfaces by sheet insertion (see cut.hpp).
+#include "isohex/sheets/cut.hpp"
+
+#include "isohex/contour/region.hpp"
+#include "isohex/error.hpp"
+#include "isohex/mesh/topology.hpp"
+#include "isohex/optimize/slide.hpp"
+#include "isohex/sheets/pillow.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+namespace isohex {
+
+std::string_view cut_keep_name(CutKeep k) {
+  switch (k) {
+    case CutKeep::both: return "both";
+    case CutKeep::inside: return "inside";
+    case CutKeep::outside: return "outside";
+  }
+  return "both";
+}
+
+std::optional<CutKeep> cut_keep_from_name(std::string_view name) {
+  for (CutKeep k : {CutKeep::both, CutKeep::inside, CutKeep::outside})
+    if (name == cut_keep_name(k)) return k;
+  return std::nullopt;
+}
+
+namespace {
+
+// One thing a vertex keeps to: cut surface `surface`, or (surface < 0) the input's boundary
+// triangles that face `facing` (one face of it: a feature edge keeps to two, a corner to three).
+struct Keep {
+  int surface = -1;
+  Vec3 facing = Vec3::Zero();
+};
+using Keeps = std::vector<Keep>;
+
+// Per boundary vertex of `mesh`: the level sets of `surfaces` it is on; where it is on none,
+// the directions of its boundary quads more than `feature_degrees` apart (the triangles).
+std::vector<Keeps> boundary_keeps(const HexMesh& mesh, const std::vector<contour::LevelSet>& surfaces,
+                                  double feature_degrees) {
+  std::vector<Keeps> keeps(mesh.points.size());
+  std::vector<std::uint8_t> on_level(mesh.points.size(), 0);
+  const double cos_limit = std::cos(feature_degrees * std::numbers::pi / 180.0);
+  const std::vector<Quad> quads = boundary_quads(mesh);
+  for (const Quad& q : quads)
+    for (Index v : q) {
+      if (on_level[v]) continue;
+      on_level[v] = 2;  // seen, on none
+      for (std::size_t k = 0; k < surfaces.size(); ++k)
+        if (surfaces[k].on(mesh.points[v])) keeps[v].push_back({static_cast<int>(k), Vec3::Zero()}), on_level[v] = 1;
+    }
+  for (const Quad& q : quads) {
+    Vec3 n = (mesh.points[q[2]] - mesh.points[q[0]]).cross(mesh.points[q[3]] - mesh.points[q[1]]);
+    if (!(n.norm() > 0)) continue;
+    n.normalize();
+    for (Index v : q) {
+      if (on_level[v] == 1) continue;
+      Keeps& k = keeps[v];
+      if (std::none_of(k.begin(), k.end(), [&](const Keep& e) { return e.facing.dot(n) >= cos_limit; }))
+        k.push_back({-1, n});
+    }
+  }
+  return keeps;
+}
+
+bool on_surface(const Keeps& k, int surface) {
+  return std::any_of(k.begin(), k.end(), [&](const Keep& e) { return e.surface == surface; });
+}
+
+bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+                  double tri_tol, double reach);
+
+// Alternating projections onto each of `keeps` in turn (slower than Newton steps, but they
+// settle where the triangles' planes change under the steps: a bumpy boundary).
+bool place_by_turns(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+                    double tri_tol, double reach) {
+  Vec3 q = x;
+  for (int round = 0; round < 1000; ++round) {
+    bool done = true;
+    for (const Keep& k : keeps) {
+      if (k.surface >= 0) {
+        const contour::LevelSet& s = cuts[static_cast<std::size_t>(k.surface)];
+        done = done && std::abs(s.level(q)) <= s.tolerance();
+      } else {
+        done = done && (tris.project(q, &k.facing) - q).norm() <= tri_tol;
+      }
+    }
+    if (done) {
+      if (!((q - x).norm() <= reach)) return false;
+      x = q;
+      return true;
+    }
+    for (const Keep& k : keeps) {
+      if (k.surface >= 0) {
+        if (!cuts[static_cast<std::size_t>(k.surface)].project(q, reach)) return false;
+      } else {
+        q = tris.project(q, &k.facing);
+      }
+    }
+    if (!((q - x).norm() <= 2 * reach)) return false;
+  }
+  return false;
+}
+
+// Moves x onto everything in `keeps` at once: Newton steps, each the least step that zeroes
+// the linearised levels (a cut's L, or the signed distance to the plane of the nearest
+// triangle facing the keep's way), else by turns. False if neither settles within `reach`.
+bool place(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+           double tri_tol, double reach) {
+  if (place_newton(x, keeps, cuts, tris, tri_tol, reach)) return true;
+  return keeps.size() <= 3 && place_by_turns(x, keeps, cuts, tris, tri_tol, reach);
+}
+
+bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+                  double tri_tol, double reach) {
+  const std::size_t k = std::min<std::size_t>(keeps.size(), 3);
+  if (k == 0) return true;
+  Vec3 q = x;
+  for (int it = 0; it < 100; ++it) {
+    Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+    Vec3 r = Vec3::Zero();
+    bool done = true;
+    for (std::size_t i = 0; i < k; ++i) {
+      Vec3 g;
+      double tol = tri_tol;
+      if (keeps[i].surface >= 0) {
+        const contour::LevelSet& s = cuts[static_cast<std::size_t>(keeps[i].surface)];
+        r[i] = s.level(q, g);
+        tol = s.tolerance();
+      } else {
+        const Vec3 foot = tris.project(q, &keeps[i].facing, &g);
+        r[i] = g.dot(q - foot);
+      }
+      J.row(i) = g.transpose();
+      done = done && std::abs(r[i]) <= tol;
+    }
+    if (done) {
+      if (!((q - x).norm() <= reach)) return false;
+      x = q;
+      return true;
+    }
+    // The least-norm solution of J d = r over the k rows: d = Jᵀ (J Jᵀ)⁻¹ r.
+    const Eigen::MatrixXd Jk = J.topRows(static_cast<Eigen::Index>(k));
+    const Eigen::MatrixXd M = Jk * Jk.transpose();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(M);
+    if (ldlt.info() != Eigen::Success || !(std::abs(M.determinant()) > 1e-12 * std::pow(M.trace() / static_cast<double>(k), static_cast<double>(k))))
+      return false;  // the surfaces are tangent there: no single point or curve to go to
+    const Eigen::VectorXd lambda = ldlt.solve(r.head(static_cast<Eigen::Index>(k)));
+    q -= Jk.transpose() * lambda;
+    if (!q.allFinite() || !((q - x).norm() <= 2 * reach)) return false;
+  }
+  return false;
+}
+
+Vec3 centroid(const HexMesh& m, Index h) {
+  Vec3 c = Vec3::Zero();
+  for (Index v : m.hexes[h]) c += m.points[v];
+  return c / 8.0;
+}
+
+// The sides of a cut (1 = inside) by the sign at each hex's centroid, or for a hex on the
+// boundary at the mean of its boundary faces' centres (the staircase then meets the boundary
+// where the surface does). Then, round after round until nothing changes: the two hexes on a
+// face of an earlier cut's surface take the side of the face's centre (an interface face on an
+// earlier surface would be on both: a face collapsed onto their curve), and a hex with four or
+// more faces towards the other side moves across.
+std::vector<std::uint8_t> classify(const HexMesh& m, const Shape& shape, const std::vector<Keeps>& keeps,
+                                   int first_cut, std::vector<std::uint8_t> side, const std::vector<std::uint8_t>& locked,
+                                   std::size_t& moved) {
+  const std::vector<std::array<Index, 6>> nb = face_neighbours(m);
+  if (side.empty()) {
+    side.resize(m.hexes.size());
+    for (Index h = 0; h < m.num_hexes(); ++h) {
+      Vec3 at = Vec3::Zero();
+      int faces = 0;
+      for (int f = 0; f < 6; ++f)
+        if (nb[h][f] < 0) {
+          for (Index v : face_vertices(m.hexes[h], f)) at += m.points[v];
+          ++faces;
+        }
+      side[h] = evaluate(shape, faces ? Vec3(at / (4.0 * faces)) : centroid(m, h)) < 0;
+    }
+  }
+  // The faces on an earlier cut's surface: all four vertices on one surface.
+  std::vector<std::pair<Index, Index>> on_earlier;  // (h, g), h < g
+  std::vector<std::uint8_t> face_side;
+  for (Index h = 0; h < m.num_hexes(); ++h)
+    for (int f = 0; f < 6; ++f) {
+      const Index g = nb[h][f];
+      if (g < h) continue;
+      const Quad q = face_vertices(m.hexes[h], f);
+      bool shared = false;
+      for (const Keep& k : keeps[q[0]])
+        shared = shared || (k.surface >= first_cut && std::all_of(q.begin() + 1, q.end(), [&](Index v) { return on_surface(keeps[v], k.surface); }));
+      if (!shared) continue;
+      Vec3 c = Vec3::Zero();
+      for (Index v : q) c += m.points[v];
+      on_earlier.push_back({h, g});
+      face_side.push_back(evaluate(shape, c / 4.0) < 0);
+    }
+  for (int round = 0; round < 100; ++round) {
+    bool changed = false;
+    for (std::size_t i = 0; i < on_earlier.size(); ++i)
+      for (Index h : {on_earlier[i].first, on_earlier[i].second})
+        if (side[h] != face_side[i] && !locked[h]) side[h] = face_side[i], changed = true;
+    std::vector<Index> flip;
+    for (Index h = 0; h < m.num_hexes(); ++h) {
+      if (locked[h]) continue;
+      int across = 0;
+      for (Index g : nb[h]) across += g >= 0 && side[g] != side[h];
+      if (across >= 4) flip.push_back(h);
+    }
+    for (Index h : flip) side[h] = !side[h];
+    moved += flip.size();
+    if (!changed && flip.empty()) break;
+  }
+  return side;
+}
+
+// Interface vertices on a surface (the boundary, an earlier cut) that the cut does not cross
+// near them: their hexes join one side (that of the vertex's sign, or of those of its hexes
+// already locked) and are locked there, so that the interface leaves them and classify() does
+// not move them back. Returns how many there were.
+std::size_t unreachable_to_one_side(const HexMesh& m, const Incidence& inc, const std::vector<std::uint8_t>& side,
+                                    const std::vector<Keeps>& keeps, int cut_id, const std::vector<contour::LevelSet>& levels,
+                                    const BoundarySurface& tris, double tri_tol, double reach,
+                                    std::vector<std::uint8_t>& next, std::vector<std::uint8_t>& locked) {
+  next = side;
+  std::size_t bad = 0;
+  for (Index v = 0; v < m.num_vertices(); ++v) {
+    if (keeps[v].empty()) continue;
+    bool in = false, out = false;
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) (side[inc.ids[k]] ? in : out) = true;
+    if (!(in && out)) continue;
+    Keeps trial = keeps[v];
+    trial.push_back({cut_id, Vec3::Zero()});
+    Vec3 x = m.points[v];
+    if (place(x, trial, levels, tris, tri_tol, reach)) continue;
+    ++bad;
+    // The side of its hexes locked before (a neighbour's), else of its own sign: the spot where
+    // the cut only grazes the surface goes to one side as a whole.
+    std::uint8_t to = levels[static_cast<std::size_t>(cut_id)].level(m.points[v]) > 0;
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+      if (locked[inc.ids[k]]) {
+        to = next[inc.ids[k]];
+        break;
+      }
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+      if (!locked[inc.ids[k]]) next[inc.ids[k]] = to, locked[inc.ids[k]] = 1;
+  }
+  return bad;
+}
+
+// Pillows the hexes whose side is `which`; the sides and keeps follow the new mesh (added and
+// removed hexes of the shrink set change side, new hexes take `which`, copies their
+// original's keeps; `origin` gets each copy's original).
+void pillow_side(HexMesh& m, std::vector<std::uint8_t>& side, std::vector<Keeps>& keeps, std::vector<Index>& origin,
+                 std::uint8_t which, double offset) {
+  std::vector<std::uint8_t> shrink(side.size());
+  for (std::size_t h = 0; h < side.size(); ++h) shrink[h] = side[h] == which;
+  PillowOptions po;
+  po.offset = offset;
+  PillowResult p = pillow(m, shrink, po);
+  for (Index h : p.added) side[h] = which;
+  for (Index h : p.removed) side[h] = !which;
+  side.resize(p.mesh.hexes.size(), which);
+  for (Index original : p.copy_of) keeps.push_back(keeps[original]), origin.push_back(original);
+  m = std::move(p.mesh);
+}
+
+// Drops the hexes whose side is not `keep` and the vertices no hex uses.
+void drop_side(HexMesh& m, std::vector<std::uint8_t>& side, std::vector<Keeps>& keeps, std::vector<Index>& origin,
+               std::vector<std::uint8_t>& sheet, std::uint8_t keep) {
+  std::vector<Index> new_id(m.points.size(), -1);
+  HexMesh out;
+  std::vector<std::uint8_t> out_side, out_sheet;
+  for (Index h = 0; h < m.num_hexes(); ++h) {
+    if (side[h] != keep) continue;
+    Hex hx = m.hexes[h];
+    for (Index& v : hx) {
+      if (new_id[v] < 0) new_id[v] = static_cast<Index>(out.points.size()), out.points.push_back(m.points[v]);
+      v = new_id[v];
+    }
+    out.hexes.push_back(hx);
+    if (m.has_blocks()) out.blocks.push_back(m.blocks[h]);
+    out_side.push_back(side[h]);
+    out_sheet.push_back(sheet[h]);
+  }
+  std::vector<Keeps> out_keeps(out.points.size());
+  std::vector<Index> out_origin(out.points.size(), -1);
+  for (std::size_t v = 0; v < new_id.size(); ++v)
+    if (new_id[v] >= 0) {
+      out_keeps[static_cast<std::size_t>(new_id[v])] = std::move(keeps[v]);
+      if (origin[v] >= 0) out_origin[static_cast<std::size_t>(new_id[v])] = new_id[static_cast<std::size_t>(origin[v])];
+      if (m.has_fixed()) out.fixed.resize(out.points.size(), 0), out.fixed[static_cast<std::size_t>(new_id[v])] = m.fixed[v];
+    }
+  m = std::move(out);
+  side = std::move(out_side);
+  sheet = std::move(out_sheet);
+  keeps = std::move(out_keeps);
+  origin = std::move(out_origin);
+}
+
+// 1 for the vertices within `rings` hex rings of the hexes flagged in `seed`.
+std::vector<std::uint8_t> near_hexes(const HexMesh& m, const Incidence& inc, const std::vector<std::uint8_t>& seed,
+                                     int rings) {
+  std::vector<std::uint8_t> near(m.points.size(), 0), hex_in(m.hexes.size(), 0);
+  for (Index h = 0; h < m.num_hexes(); ++h)
+    if (seed[h]) {
+      hex_in[h] = 1;
+      for (Index v : m.hexes[h]) near[v] = 1;
+    }
+  for (int r = 0; r < rings; ++r) {
+    std::vector<std::uint8_t> next = near;
+    for (Index v = 0; v < m.num_vertices(); ++v) {
+      if (!near[v]) continue;
+      for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+        for (Index w : m.hexes[inc.ids[k]]) next[w] = 1;
+    }
+    near = std::move(next);
+  }
+  return near;
+}
+
+// The optimisers' constraint for a vertex: at most two things to keep to, and one of them a
+// cut (the triangles' two faces of a feature edge are not a curve BoundarySurface follows).
+BoundarySurface::Constraint constraint_of(const Keeps& k) {
+  BoundarySurface::Constraint c;
+  if (k.empty()) return c;
+  const auto id = [](const Keep& e) { return e.surface >= 0 ? static_cast<std::int8_t>(e.surface) : BoundarySurface::kTriangles; };
+  if (k.size() == 1) {
+    c.first = id(k[0]);
+  } else if (k.size() == 2 && (k[0].surface >= 0 || k[1].surface >= 0)) {
+    c.first = id(k[0]), c.second = id(k[1]);
+  } else {
+    c.pinned = true;
+  }
+  return c;
+}
+
+// What the cuts share: the input's boundary for projections, each vertex's keeps, the cut
+// surfaces so far and the mesh as it is cut.
+struct Cutting {
+  const HexMesh& input;
+  const CutOptions& options;
+  double scale, tri_tol, reach;
+  BoundarySurface tris;  // the input's boundary triangles
+  HexMesh& m;
+  std::vector<contour::LevelSet> levels;  // the boundary's level sets, then the cuts so far
+  int first_cut;                          // levels[first_cut + j] is cut j
+  std::vector<Keeps> keeps;
+
+  Cutting(const HexMesh& in, const CutOptions& o, double s, HexMesh& mesh)
+      : input(in), options(o), scale(s), tri_tol(1e-12 * s), reach(0.25 * s), tris(in, o.feature_degrees), m(mesh),
+        levels(o.boundary), first_cut(static_cast<int>(o.boundary.size())),
+        keeps(boundary_keeps(in, o.boundary, o.feature_degrees)) {
+    m = in;
+  }
+
+  // The sides of cut j (1 = inside), the vertices the cut cannot reach sent to one side.
+  std::vector<std::uint8_t> sides(int cut_id, const Shape& shape, CutStep& step) const {
+    std::vector<std::uint8_t> locked(m.hexes.size(), 0);
+    std::vector<std::uint8_t> side = classify(m, shape, keeps, first_cut, {}, locked, step.moved_across);
+    const Incidence inc = vertex_hexes(m);
+    std::vector<std::uint8_t> next;
+    for (int round = 0;
+         round < 20 && unreachable_to_one_side(m, inc, side, keeps, cut_id, levels, tris, tri_tol, reach, next, locked) > 0;
+         ++round) {
+      for (std::size_t h = 0; h < side.size(); ++h) step.moved_across += next[h] != side[h];
+      side = classify(m, shape, keeps, first_cut, next, locked, step.moved_across);
+    }
+    step.inside_hexes = static_cast<std::size_t>(std::count(side.begin(), side.end(), 1));
+    step.outside_hexes = side.size() - step.inside_hexes;
+    if ((step.inside_hexes == 0 || step.outside_hexes == 0) && options.skip_missing) return {};
+    if (step.inside_hexes == 0 || step.outside_hexes == 0)
+      throw Error(fmt::format("cut: the surface {} misses the mesh: every hex is {} it", step.surface,
+                              step.inside_hexes == 0 ? "outside" : "inside"));
+    return side;
+  }
+
+  // The vertices of the faces between the two sides keep to the cut.
+  void mark_interface(int cut_id, const std::vector<std::uint8_t>& side) {
+    const std::vector<std::array<Index, 6>> nb = face_neighbours(m);
+    std::vector<std::uint8_t> mark(m.points.size(), 0);
+    for (Index h = 0; h < m.num_hexes(); ++h)
+      for (int f = 0; f < 6; ++f)
+        if (const Index g = nb[h][f]; g >= 0 && side[g] != side[h])
+          for (Index v : face_vertices(m.hexes[h], f)) mark[v] = 1;
+    for (std::size_t v = 0; v < mark.size(); ++v)
+      if (mark[v]) keeps[v].push_back({cut_id, Vec3::Zero()});
+  }
+
+  // Both sides kept: inside, each block b becomes a new block (in the order of b), so that the
+  // pieces of earlier cuts stay apart.
+  void split_blocks(const std::vector<std::uint8_t>& side) {
+    if (!m.has_blocks()) m.blocks.assign(m.hexes.size(), 0);
+    std::vector<Index> inside;
+    for (Index h = 0; h < m.num_hexes(); ++h)
+      if (side[h]) inside.push_back(m.blocks[h]);
+    std::sort(inside.begin(), inside.end());
+    inside.erase(std::unique(inside.begin(), inside.end()), inside.end());
+    const Index top = *std::max_element(m.blocks.begin(), m.blocks.end());
+    for (Index h = 0; h < m.num_hexes(); ++h)
+      if (side[h])
+        m.blocks[h] = top + 1 + static_cast<Index>(std::lower_bound(inside.begin(), inside.end(), m.blocks[h]) - inside.begin());
+  }
+
+  // The interface vertices onto the cut (its curves, its corners); the copies the sheets made
+  // of them move with them, so that each sheet keeps its thickness and side; then every other
+  // vertex onto what it keeps to (those already there stay: |L| within tolerance).
+  void place_all(int cut_id, const std::vector<Index>& origin, CutStep& step) {
+    std::vector<Vec3> moved(m.points.size(), Vec3::Zero());
+    Vec3 first = Vec3::Zero();
+    for (Index v = 0; v < m.num_vertices(); ++v) {
+      const Keeps& k = keeps[v];
+      if (!on_surface(k, cut_id)) continue;
+      const Vec3 was = m.points[v];
+      if (!place(m.points[v], k, levels, tris, tri_tol, reach) && step.unplaced++ == 0) first = m.points[v];
+      moved[v] = m.points[v] - was;
+      ++step.surface_vertices;
+      step.curve_vertices += k.size() == 2;
+      step.corner_vertices += k.size() >= 3;
+    }
+    for (Index v = 0; v < m.num_vertices(); ++v) {
+      if (on_surface(keeps[v], cut_id)) continue;
+      const Vec3 was = m.points[v];
+      if (origin[v] >= 0) m.points[v] += moved[origin[v]];
+      if (keeps[v].empty() || place(m.points[v], keeps[v], levels, tris, tri_tol, reach)) continue;
+      // Moved with its original, the copy may have no foot on its surface near it (a fold of
+      // an isosurface): it goes back there from where pillowing put it instead.
+      m.points[v] = was;
+      if (!place(m.points[v], keeps[v], levels, tris, tri_tol, reach) && step.unplaced++ == 0) first = m.points[v];
+
+    }
+    if (step.unplaced > 0)
+      throw Error(fmt::format("cut: the surface {} cannot be reached from {} vertices of the new sheet: it is tangent to "
+                              "the mesh's boundary or to an earlier cut there (e.g. vertex at {:.6g} {:.6g} {:.6g}); "
+                              "move or resize it a little",
+                              step.surface, step.unplaced, first.x(), first.y(), first.z()));
+  }
+
+  // Untangle, shape and worst pass of the vertices within `rings` of the new sheets, each
+  // kept on what it lies on.
+  OptimizeResult optimise(const std::vector<std::uint8_t>& sheet) {
+    std::vector<BoundarySurface::Constraint> cons(m.points.size());
+    for (std::size_t v = 0; v < cons.size(); ++v) cons[v] = constraint_of(keeps[v]);
+    const BoundarySurface surface(m, input, levels, cons);
+    const Incidence inc = vertex_hexes(m);
+    const std::vector<std::uint8_t> near = near_hexes(m, inc, sheet, options.rings);
+    std::vector<std::uint8_t> fixed = surface.fixed_mask();
+    for (std::size_t v = 0; v < fixed.size(); ++v) fixed[v] = fixed[v] || !near[v];
+    OptimizeOptions o = options.optimize_options;
+    o.untangle_options.surface = o.shape_options.surface = o.worst_options.surface = &surface;
+    o.untangle_options.incidence = o.shape_options.incidence = o.worst_options.incidence = &inc;
+    o.untangle_options.progress = o.shape_options.progress = o.worst_options.progress = options.progress;
+    return optimize_mesh(m, fixed, o);
+  }
+
+  CutStep cut_once(const Shape& shape) {
+    CutStep step;
+    step.surface = to_shape_string(shape);
+    const int cut_id = static_cast<int>(levels.size());
+    levels.emplace_back(std::make_shared<const Shape>(shape), scale);
+    std::vector<std::uint8_t> side = sides(cut_id, shape, step);
+    if (side.empty()) {
+      step.missed = true;
+      return step;
+    }
+    const Index before = m.num_hexes();
+    std::vector<Index> origin(m.points.size(), -1);  // per vertex: the one it copies (this cut's sheets)
+    if (options.keep != CutKeep::outside) pillow_side(m, side, keeps, origin, 1, options.offset);
+    if (options.keep != CutKeep::inside) pillow_side(m, side, keeps, origin, 0, options.offset);
+    step.sheet_hexes = static_cast<std::size_t>(m.num_hexes() - before);
+    std::vector<std::uint8_t> sheet(m.hexes.size(), 0);
+    std::fill(sheet.begin() + before, sheet.end(), 1);
+    mark_interface(cut_id, side);
+    if (options.keep == CutKeep::both) {
+      split_blocks(side);
+    } else {
+      const std::uint8_t kept = options.keep == CutKeep::inside ? 1 : 0;
+      step.dropped_hexes = static_cast<std::size_t>(std::count(side.begin(), side.end(), !kept));
+      drop_side(m, side, keeps, origin, sheet, kept);
+    }
+    place_all(cut_id, origin, step);
+    if (options.optimize) {
+      step.optimisation = optimise(sheet);
+      step.optimized = true;
+    }
+    return step;
+  }
+};
+
+}  // namespace
+
+CutResult cut(const HexMesh& input, const std::vector<Shape>& surfaces, const CutOptions& options) {
+  if (surfaces.empty()) throw Error("cut: no cut surface given");
+  if (surfaces.size() > 100) throw Error("cut: at most 100 cut surfaces");
+  if (!(options.offset > 0 && options.offset < 1))
+    throw Error(fmt::format("cut: the sheet offset must be in (0, 1), got {}", options.offset));
+  if (input.hexes.empty()) throw Error("cut: the mesh has no hexes");
+  double scale = options.scale;
+  if (!(scale > 0)) {
+    Vec3 lo = input.points.front(), hi = lo;
+    for (const Vec3& p : input.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    scale = (hi - lo).norm();
+  }
+  if (!(scale > 0) || !std::isfinite(scale)) throw Error("cut: the mesh has no extent");
+
+  CutResult res;
+  Cutting c(input, options, scale, res.mesh);
+  for (const Shape& s : surfaces) res.steps.push_back(c.cut_once(s));
+
+  // Per cut: its quads (all four vertices on it) and how far its vertices are from it.
+  const HexMesh& m = res.mesh;
+  res.surface_quads.resize(surfaces.size());
+  res.max_distance.assign(surfaces.size(), 0.0);
+  for (const QuadFace& q : build_quads(m))
+    for (std::size_t j = 0; j < surfaces.size(); ++j)
+      if (std::all_of(q.vertices.begin(), q.vertices.end(),
+                      [&](Index v) { return on_surface(c.keeps[v], c.first_cut + static_cast<int>(j)); }))
+        res.surface_quads[j].push_back(q.vertices);
+  for (Index v = 0; v < m.num_vertices(); ++v)
+    for (const Keep& k : c.keeps[v])
+      if (k.surface >= c.first_cut) {
+        const auto s = static_cast<std::size_t>(k.surface);
+        const double d = std::abs(c.levels[s].level(m.points[v])) / scale;
+        double& worst = res.max_distance[s - static_cast<std::size_t>(c.first_cut)];
+        worst = std::max(worst, d);
+      }
+  // What the optimisers after the cut need to keep every vertex where it lies.
+  res.surfaces = c.levels;
+  res.constraints.resize(m.points.size());
+  for (std::size_t v = 0; v < res.constraints.size(); ++v) res.constraints[v] = constraint_of(c.keeps[v]);
+  return res;
+}
+
+}  // namespace isohex

@@ -1,0 +1,186 @@
+#!/usr/bin/python3
+"""Oracle test: meshes cut by `isohex cut`, measured by VTK and numpy, not by isohex.
+
+- A 12^3 cube carved by three overlapping spheres (the paper's figures 6-7): VTK's scaled
+  Jacobian (vtkMeshQuality) at least 0.3 everywhere, none below 0.2; every point of the boundary
+  surface (vtkDataSetSurfaceFilter) on the cube's faces or on one of the spheres to 1e-9 of the
+  diagonal and outside every sphere; the creases: boundary points on two surfaces at once.
+- The cube cut by a plane, both sides kept: two blocks (cell data "block"), every point the two
+  blocks share on the plane, both blocks closed and conforming (each block's surface from VTK
+  is a closed manifold: every edge of it in exactly two of its quads), none below 0.2.
+- With the shared data, the paper's figure 5: cthead's skin (iso 600, h 4) cut by the plane
+  y = 110 behind the face (`isohex mesh --cut`), both sides kept: two blocks, none below 0.2 by
+  VTK, the blocks' shared points on the plane (1e-9) and the boundary points on the plane (the
+  crease; those on the box's faces aside) on the isosurface to 1e-6 of the value range (trilinear interpolation of the raw volume here,
+  by numpy).
+Exits non-zero on any failure.
+"""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+from oracle_support import check, finish, oracle_args
+from vtk_support import hex_quality, read_vtu
+
+SPHERES = [((2, 2, 2), 1.2), ((2, 0.8, 1.0), 0.75), ((1.0, 2, 1.5), 0.7)]
+
+
+def run(cmd):
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    return p.returncode, p.stdout
+
+
+def surface(grid):
+    s = vtk.vtkDataSetSurfaceFilter()
+    s.SetInputData(grid)
+    s.Update()
+    return s.GetOutput()
+
+
+def closed_manifold(poly):
+    """Every edge of the polygons in exactly two of them."""
+    edges = {}
+    for i in range(poly.GetNumberOfCells()):
+        ids = poly.GetCell(i).GetPointIds()
+        n = ids.GetNumberOfIds()
+        for k in range(n):
+            a, b = ids.GetId(k), ids.GetId((k + 1) % n)
+            key = (min(a, b), max(a, b))
+            edges[key] = edges.get(key, 0) + 1
+    return all(c == 2 for c in edges.values()), len(edges)
+
+
+def test_spheres(cli, tmp):
+    cube, out = os.path.join(tmp, "cube.vtu"), os.path.join(tmp, "carved.vtu")
+    rc, log = run([cli, "generate", "box", "-n", "12", "--size", "2", "-o", cube])
+    check(rc == 0, f"generate: {log}")
+    cmd = [cli, "cut", cube, "-o", out, "--keep", "outside"]
+    for (c, r) in SPHERES:
+        cmd += ["--surface", "sphere({},{},{},{})".format(*c, r)]
+    rc, log = run(cmd)
+    if not check(rc == 0, f"isohex cut (three spheres) exit {rc}: {log[-800:]}"):
+        return
+    grid = read_vtu(out)
+    sj = hex_quality(grid)
+    print(f"three spheres: {grid.GetNumberOfCells()} hexes, VTK scaled Jacobian min {sj.min():.4f} mean {sj.mean():.4f}")
+    check(sj.min() >= 0.3, f"three spheres: VTK's min scaled Jacobian {sj.min():.4f} >= 0.3")
+    check(int((sj < 0.2).sum()) == 0, f"three spheres: {(sj < 0.2).sum()} hexes below 0.2 by VTK")
+    pts = vtk_to_numpy(surface(grid).GetPoints().GetData()).astype(np.float64)
+    tol = 1e-9 * 2 * np.sqrt(3)
+    on_box = np.min(np.minimum(np.abs(pts), np.abs(pts - 2)), axis=1) <= tol
+    dist = np.array([np.abs(np.linalg.norm(pts - np.array(c), axis=1) - r) for c, r in SPHERES])
+    inside = np.array([np.linalg.norm(pts - np.array(c), axis=1) < r - tol for c, r in SPHERES])
+    count = on_box.astype(int) + (dist <= tol).sum(axis=0)
+    check(bool((count >= 1).all()), f"three spheres: {(count == 0).sum()} boundary points on no surface "
+                                    f"(farthest {np.min(np.vstack([dist, np.where(on_box, 0, 1)[None]]), axis=0).max():.3g})")
+    check(not inside.any(), f"three spheres: {inside.any(axis=0).sum()} boundary points inside a carved sphere")
+    check(int((count >= 2).sum()) > 80, f"three spheres: {(count >= 2).sum()} boundary points on creases (> 80)")
+    for j, (c, r) in enumerate(SPHERES):
+        check(int((dist[j] <= tol).sum()) > 40, f"sphere {j + 1}: {(dist[j] <= tol).sum()} boundary points on it")
+
+
+def test_plane(cli, tmp):
+    cube, out = os.path.join(tmp, "cube.vtu"), os.path.join(tmp, "halves.vtu")
+    rc, log = run([cli, "cut", cube, "-o", out, "--surface", "plane(1,1,1, 1,0.3,0.2)"])
+    if not check(rc == 0, f"isohex cut (plane, both sides) exit {rc}: {log[-800:]}"):
+        return
+    grid = read_vtu(out)
+    sj = hex_quality(grid)
+    check(int((sj < 0.2).sum()) == 0 and sj.min() > 0.3, f"plane: VTK's min scaled Jacobian {sj.min():.4f}")
+    blocks = vtk_to_numpy(grid.GetCellData().GetArray("block"))
+    check(sorted(set(blocks.tolist())) == [0, 1], f"plane: blocks {sorted(set(blocks.tolist()))}")
+    n = np.array([1, 0.3, 0.2]) / np.linalg.norm([1, 0.3, 0.2])
+    hexes = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
+    pts = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
+    shared = np.intersect1d(np.unique(hexes[blocks == 0]), np.unique(hexes[blocks == 1]))
+    off = np.abs((pts[shared] - 1) @ n)
+    check(len(shared) > 150 and off.max() <= 1e-9, f"plane: {len(shared)} points the blocks share, "
+                                                   f"farthest {off.max():.3g} from the plane")
+    # Conforming: the faces of block 0's hexes that are on the plane are faces of block 1's
+    # hexes too (the same four points), and the other way round.
+    faces = [(0, 4, 7, 3), (1, 2, 6, 5), (0, 1, 5, 4), (3, 7, 6, 2), (0, 3, 2, 1), (4, 5, 6, 7)]
+
+    def plane_faces(b):
+        out = set()
+        for h in hexes[blocks == b]:
+            for f in faces:
+                q = h[list(f)]
+                if np.abs((pts[q] - 1) @ n).max() <= 1e-9:
+                    out.add(tuple(sorted(q.tolist())))
+        return out
+    f0, f1 = plane_faces(0), plane_faces(1)
+    check(len(f0) > 150 and f0 == f1, f"plane: {len(f0)} and {len(f1)} faces on the plane, "
+                                      f"{len(f0 ^ f1)} not shared by both blocks")
+    for b in (0, 1):
+        t = vtk.vtkThreshold()
+        t.SetInputData(grid)
+        t.SetInputArrayToProcess(0, 0, 0, vtk.vtkDataObject.FIELD_ASSOCIATION_CELLS, "block")
+        t.SetLowerThreshold(b - 0.5)
+        t.SetUpperThreshold(b + 0.5)
+        t.Update()
+        ok, edges = closed_manifold(surface(t.GetOutput()))
+        check(ok, f"plane: block {b}'s surface is a closed manifold ({edges} edges)")
+
+
+def trilinear(vol, spacing, p):
+    """The trilinear interpolant of vol[z, y, x] at world points p (N x 3), origin 0."""
+    g = p / spacing
+    i = np.clip(np.floor(g).astype(int), 0, np.array(vol.shape[::-1]) - 2)
+    f = g - i
+    out = np.zeros(len(p))
+    for dz in (0, 1):
+        for dy in (0, 1):
+            for dx in (0, 1):
+                w = (f[:, 0] if dx else 1 - f[:, 0]) * (f[:, 1] if dy else 1 - f[:, 1]) * (f[:, 2] if dz else 1 - f[:, 2])
+                out += w * vol[i[:, 2] + dz, i[:, 1] + dy, i[:, 0] + dx]
+    return out
+
+
+def test_cthead(cli, data, tmp):
+    raw = os.path.join(data, "volumes", "cthead_256x256x113_int16be.raw")
+    if not os.path.exists(raw):
+        print("SKIP (cthead): no shared data")
+        return
+    out = os.path.join(tmp, "head_cut.vtu")
+    rc, log = run([cli, "mesh", raw, "--dims", "256", "256", "113", "--type", "i16", "--endian", "big", "--spacing", "1",
+                   "1", "2", "--iso", "600", "--cell-size", "4", "--cut", "plane(0,110,0, 0,1,0)", "-o", out])
+    if not check(rc == 0, f"isohex mesh --cut (cthead) exit {rc}: {log[-800:]}"):
+        return
+    grid = read_vtu(out)
+    sj = hex_quality(grid)
+    print(f"cthead cut at y = 110: {grid.GetNumberOfCells()} hexes, VTK scaled Jacobian min {sj.min():.4f}")
+    check(int((sj < 0.2).sum()) == 0, f"cthead cut: {(sj < 0.2).sum()} hexes below 0.2 by VTK")
+    blocks = vtk_to_numpy(grid.GetCellData().GetArray("block"))
+    check(sorted(set(blocks.tolist())) == [0, 1], f"cthead cut: blocks {sorted(set(blocks.tolist()))}")
+    hexes = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
+    pts = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
+    shared = np.intersect1d(np.unique(hexes[blocks == 0]), np.unique(hexes[blocks == 1]))
+    check(len(shared) > 500 and np.abs(pts[shared, 1] - 110).max() <= 1e-9,
+          f"cthead cut: {len(shared)} shared points, farthest {np.abs(pts[shared, 1] - 110).max():.3g} from the plane")
+    vol = np.fromfile(raw, dtype=">i2").reshape(113, 256, 256).astype(np.float64)
+    value_range = vol.max() - vol.min()
+    boundary = vtk_to_numpy(surface(grid).GetPoints().GetData()).astype(np.float64)
+    # The boundary points on the plane are the crease (the plane is inside the solid, between
+    # the blocks) and, at z = 0 and z = 224, where it meets the volume's box (the head is cut
+    # by the scan's bottom and top).
+    z = boundary[:, 2]
+    on_plane = boundary[(np.abs(boundary[:, 1] - 110) <= 1e-9) & (z > 1e-9) & (z < 224 - 1e-9)]
+    level = np.abs(trilinear(vol, np.array([1.0, 1.0, 2.0]), on_plane) - 600) / value_range
+    check(len(on_plane) > 50 and level.max() <= 1e-6,
+          f"cthead cut: {len(on_plane)} crease points, |f - 600| / range at most {level.max():.2g} (1e-6 allowed)")
+    print(f"cthead cut: {len(on_plane)} crease points, |f - 600| / range at most {level.max():.2g}")
+
+
+def main():
+    args = oracle_args(__doc__.split("\n")[0])
+    test_spheres(args.cli, args.tmp)
+    test_plane(args.cli, args.tmp)
+    test_cthead(args.cli, args.data, args.tmp)
+    return finish()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
