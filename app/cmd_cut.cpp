@@ -102,7 +102,7 @@ void register_cut(CLI::App& app) {
       "Examples:\n"
       "  isohex generate box -o cube.vtu -n 12 --size 2\n"
       "  isohex cut cube.vtu -o carved.vtu --surface \"sphere(1,1,1, 0.6)\" --keep outside\n"
-      "  isohex cut cube.vtu -o two.vtu --surface \"plane(0.5,0.5,0.5, 1,0.3,0.2)\"   # two blocks, conforming\n"
+      "  isohex cut cube.vtu -o two.vtu --surface \"plane(1,1,1, 1,0.3,0.2)\"   # two blocks, conforming\n"
       "  isohex cut cube.vtu -o c.vtu --surface \"sphere(1,1,1,0.6)\" --surface \"sphere(0,0,1,0.5)\" --keep outside");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp .msh .exo)")->required();
   cmd->add_option("-o,--output", a->output, "The cut mesh")->required();

@@ -101,6 +101,19 @@ TEST(Cut, CubeCarvedByThreeOverlappingSpheres) {
   }
   EXPECT_GT(on_sphere, 300u);
   EXPECT_GT(curve, 80u);  // the creases: strings of edges on the curves
+  ASSERT_EQ(m.face_sets.size(), 3u);  // "cut1".."cut3": boundary faces on each sphere
+  const std::vector<QuadFace> all = build_quads(m);
+  std::set<std::pair<Index, int>> boundary_faces;
+  for (const QuadFace& q : all)
+    if (q.is_boundary()) boundary_faces.insert({q.hex[0], q.local[0]});
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_EQ(m.face_sets[j].name, "cut" + std::to_string(j + 1));
+    EXPECT_EQ(m.face_sets[j].faces.size(), r.surface_quads[j].size());
+    for (const auto& [h, f] : m.face_sets[j].faces) {
+      EXPECT_TRUE(boundary_faces.count({h, f})) << "hex " << h << " face " << int(f);
+      for (Index v : face_vertices(m.hexes[h], f)) EXPECT_LE(balls[j].distance(m.points[v]), 1e-9 * scale);
+    }
+  }
   for (std::size_t j = 0; j < 3; ++j) {
     EXPECT_GT(r.surface_quads[j].size(), 50u);
     EXPECT_LE(r.max_distance[j], 1e-9);
@@ -137,6 +150,17 @@ TEST(Cut, PlaneKeepsBothSidesConforming) {
   }
   EXPECT_EQ(interface, r.surface_quads[0].size());
   EXPECT_GT(interface, 150u);
+  // The two sides as face sets: the faces of the inside (block 1) and outside hexes on the plane.
+  ASSERT_EQ(m.face_sets.size(), 2u);
+  EXPECT_EQ(m.face_sets[0].name, "cut1_inside");
+  EXPECT_EQ(m.face_sets[1].name, "cut1_outside");
+  for (const FaceSet& fs : m.face_sets) {
+    EXPECT_EQ(fs.faces.size(), interface);
+    for (const auto& [h, f] : fs.faces) {
+      EXPECT_EQ(m.blocks[h], fs.name == "cut1_inside" ? 1 : 0);
+      for (Index v : face_vertices(m.hexes[h], f)) EXPECT_LE(std::abs(n.dot(m.points[v] - p0)), 1e-9);
+    }
+  }
   for (const auto& [h, k] : faces_on_cut) EXPECT_EQ(k, 1) << "hex " << h << " has " << k << " faces on the cut";
   // Sharp creases: keep one side, and across every boundary edge on the plane the two quads'
   // normals differ by the angle between the plane and the cube's face.
@@ -256,6 +280,16 @@ TEST(Cut, CommandLine) {
   EXPECT_NE(out.find("below 0.2: 0"), std::string::npos) << out;
   EXPECT_NE(out.find("0 of "), std::string::npos) << out;
   EXPECT_EQ(run_cli("quality " + quote(dir / "carved.vtu"), &out), 0) << out;
+  // The cut's faces as an Abaqus surface of their own, and an Exodus side set.
+  ASSERT_EQ(run_cli("cut " + quote(dir / "cube8.vtu") + " -o " + quote(dir / "carved.inp") +
+                        " --surface 'sphere(2,2,2,1.1)' --keep outside",
+                    &out),
+            0)
+      << out;
+  const std::string inp = io::read_file(dir / "carved.inp");
+  EXPECT_NE(inp.find("*SURFACE, NAME=CUT1, TYPE=ELEMENT"), std::string::npos);
+  EXPECT_NE(inp.find("*SURFACE, NAME=BOUNDARY, TYPE=ELEMENT"), std::string::npos);
+  EXPECT_EQ(run_cli("check " + quote(dir / "carved.inp"), &out), 0) << out;
   // A bad expression: exit 2, the option and the column named, nothing written.
   EXPECT_EQ(run_cli("cut " + quote(dir / "cube8.vtu") + " -o " + quote(dir / "bad.vtu") + " --surface 'sphere(1,2'",
                     &out),

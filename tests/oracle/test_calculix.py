@@ -16,7 +16,8 @@ other end, *NODE PRINT of U); ccx must print "Job finished" and no *ERROR or *WA
   of its coordinates: its deflection must be the first one's x 1000 (to 1e-5).
 * Meshes of `isohex cut`: a 12^3 cube (side 2) carved by three overlapping spheres, and the
   cube cut by a plane into two conforming blocks: clamped at z = 0, loaded sideways at z = 2;
-  det J > 0 at every Gauss point (numpy), ccx finishes, the top moves along the load.
+  det J > 0 at every Gauss point (numpy), ccx finishes, the top moves along the load; then a
+  pressure on the surface CUT1 isohex wrote (the first sphere's cavity) pushes its nodes out.
 * Unless ISOHEX_CCX_PIPELINE=0: the meshes of `isohex mesh` on the headsq and
   MR head rows of scripts/paper_table.py (its case list), written as .inp: the main part's
   bottom (z within 1 % of its height above its lowest node) clamped, a sideways load on its
@@ -87,17 +88,17 @@ def id_lines(ids):
     return "".join(", ".join(str(i) for i in ids[k:k + 16]) + "\n" for k in range(0, len(ids), 16))
 
 
-def solve(ccx, work, mesh_inp, clamped, loads, printed):
+def solve(ccx, work, mesh_inp, clamped, loads, printed, step_lines=""):
     """Runs a static deck that includes `mesh_inp` (in `work`): `clamped` nodes held in x, y, z,
-    `loads` {node: (dof, force)}, U printed for `printed`. Returns ccx's output and
-    {node: (ux, uy, uz)} from job.dat (empty when ccx failed)."""
+    `loads` {node: (dof, force)} (and `step_lines`, more loads), U printed for `printed`. Returns
+    ccx's output and {node: (ux, uy, uz)} from job.dat (empty when ccx failed)."""
     # A deck of its own *HEADING: ccx refuses a second one in the included file.
     deck = (f"*HEADING\nisohex oracle test_calculix\n*INCLUDE, INPUT={os.path.basename(mesh_inp)}\n"
             f"*NSET, NSET=CLAMPED\n{id_lines(clamped)}*NSET, NSET=PRINTED\n{id_lines(printed)}"
             f"*MATERIAL, NAME=ELASTIC\n*ELASTIC\n{E!r}, {NU!r}\n*SOLID SECTION, ELSET=ALLHEXES, MATERIAL=ELASTIC\n"
-            "*BOUNDARY\nCLAMPED, 1, 3, 0.\n*STEP\n*STATIC\n*CLOAD\n"
-            + "".join(f"{n}, {dof}, {force!r}\n" for n, (dof, force) in sorted(loads.items()))
-            + "*NODE PRINT, NSET=PRINTED\nU\n*END STEP\n")
+            "*BOUNDARY\nCLAMPED, 1, 3, 0.\n*STEP\n*STATIC\n"
+            + ("*CLOAD\n" + "".join(f"{n}, {dof}, {force!r}\n" for n, (dof, force) in sorted(loads.items())) if loads else "")
+            + step_lines + "*NODE PRINT, NSET=PRINTED\nU\n*END STEP\n")
     with open(os.path.join(work, "job.inp"), "w") as f:
         f.write(deck)
     rc, out = run([ccx, "-i", "job"], cwd=work)
@@ -309,6 +310,20 @@ def test_cut(cli, ccx, tmp):
               + ("Job finished" if "Job finished" in out else out[-400:]))
         if accepted(out, name):
             check(len(u) == len(top) and sum(v[0] for v in u.values()) > 0, f"{name}: the loaded top moves along the load")
+    # A pressure on the first sphere's cavity through the surface CUT1 that isohex wrote: its
+    # nodes move away from the sphere's centre (the faces are the right ones, facing out).
+    work = os.path.join(tmp, "cube_carved_by_three_spheres")
+    inp = os.path.join(work, "mesh.inp")
+    if os.path.exists(inp):
+        nodes, elements = read_inp(inp)
+        centre, radius = (2.0, 2.0, 2.0), 1.2
+        on_sphere = [n for n, p in nodes.items() if abs(sum((p[k] - centre[k]) ** 2 for k in range(3)) ** 0.5 - radius) < 1e-6]
+        clamped = [n for n, p in nodes.items() if p[2] == 0.0]
+        out, u = solve(ccx, work, inp, clamped, {}, on_sphere, "*DSLOAD\nCUT1, P, 1.0\n")
+        if accepted(out, "pressure on the surface CUT1") and check(len(u) == len(on_sphere) > 20, "CUT1: U of its nodes"):
+            outward = sum(sum(u[n][k] * (nodes[n][k] - centre[k]) for k in range(3)) for n in on_sphere)
+            check(outward > 0, f"a pressure on CUT1 pushes its nodes away from the sphere's centre ({outward:.3g})")
+            print(f"pressure on CUT1: {len(on_sphere)} nodes on the sphere, mean outward motion {outward / len(on_sphere):.3g}")
 
 
 def main():

@@ -80,6 +80,17 @@ def test_spheres(cli, tmp):
     check(int((count >= 2).sum()) > 80, f"three spheres: {(count >= 2).sum()} boundary points on creases (> 80)")
     for j, (c, r) in enumerate(SPHERES):
         check(int((dist[j] <= tol).sum()) > 40, f"sphere {j + 1}: {(dist[j] <= tol).sum()} boundary points on it")
+    # The same cut written as Exodus II: VTK's reader finds a side set per sphere beside "boundary".
+    exo = os.path.join(tmp, "carved.exo")
+    rc, log = run(cmd[:3] + ["-o", exo] + cmd[5:])
+    if check(rc == 0, f"isohex cut to .exo exit {rc}: {log[-400:]}"):
+        r = vtk.vtkExodusIIReader()
+        r.SetFileName(exo)
+        r.UpdateInformation()
+        kind = vtk.vtkExodusIIReader.SIDE_SET
+        names = [r.GetObjectName(kind, i) for i in range(r.GetNumberOfObjects(kind))]
+        check(sorted(n.split(":")[0].strip().lower() for n in names) == ["boundary", "cut1", "cut2", "cut3"],
+              f"Exodus side sets read by VTK: {names}")
 
 
 def test_plane(cli, tmp):

@@ -10,7 +10,8 @@
 // the fixed vertices. Every other keyword is skipped with its data lines.
 //
 // The writer adds what a solver deck needs to refer to: *ELSET ALLHEXES, *NSET BOUNDARY
-// (the boundary nodes) and *SURFACE BOUNDARY, the boundary quads as element faces S1..S6
+// (the boundary nodes) and *SURFACE BOUNDARY, the boundary quads as element faces S1..S6,
+// and one *SURFACE per named face set of the mesh (a cut's surface)
 // in Abaqus' C3D8 face numbering (solver_sets.hpp). Every field of its data lines fits in
 // the 20 characters CalculiX reads a number from (abaqus.hpp), every line in the 256
 // characters Abaqus allows.
@@ -525,6 +526,14 @@ void write_inp(std::ostream& out, const HexMesh& mesh) {
   const std::vector<BoundaryFace> faces = boundary_faces(mesh);
   if (!faces.empty()) text.print("*SURFACE, NAME=BOUNDARY, TYPE=ELEMENT\n");
   for (const BoundaryFace& f : faces) text.print("{}, S{}\n", f.hex + 1, kAbaqusFaceOfVtkFace[f.face]);
+  // Named face sets (a cut's surface): element-based surfaces of their own.
+  for (const FaceSet& fs : mesh.face_sets) {
+    if (fs.faces.empty()) continue;
+    std::string name = fs.name;
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    text.print("*SURFACE, NAME={}, TYPE=ELEMENT\n", name);
+    for (const auto& [h, f] : fs.faces) text.print("{}, S{}\n", h + 1, kAbaqusFaceOfVtkFace[static_cast<std::size_t>(f)]);
+  }
   std::vector<Index> fixed;
   for (std::size_t v = 0; v < mesh.fixed.size(); ++v)
     if (mesh.fixed[v]) fixed.push_back(static_cast<Index>(v));

@@ -151,8 +151,12 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
   for (std::size_t v = 0; v < mesh.fixed.size(); ++v)
     if (mesh.fixed[v]) fixed_nodes.push_back(static_cast<int>(v) + 1);
   const int num_node_sets = (bnodes.empty() ? 0 : 1) + (fixed_nodes.empty() ? 0 : 1);
+  std::vector<const FaceSet*> named;  // the mesh's non-empty face sets: side sets 2, 3, ...
+  for (const FaceSet& fs : mesh.face_sets)
+    if (!fs.faces.empty()) named.push_back(&fs);
+  const int num_side_sets = (faces.empty() ? 0 : 1) + static_cast<int>(named.size());
   check(api().ex_put_init(id, "isohex hex mesh", 3, mesh.num_vertices(), mesh.num_hexes(),
-                    static_cast<int64_t>(blocks.values.size()), num_node_sets, faces.empty() ? 0 : 1),
+                    static_cast<int64_t>(blocks.values.size()), num_node_sets, num_side_sets),
         file, "writing the header");
 
   if (!mesh.points.empty()) {
@@ -201,9 +205,25 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
     }
     check(api().ex_put_side_set_param(id, 1, static_cast<int64_t>(faces.size()), 0), file, "writing the side set");
     check(api().ex_put_side_set(id, 1, elems.data(), sides.data()), file, "writing the side set");
-    std::vector<std::string> sset = {"boundary"};
+  }
+  if (num_side_sets > 0) {
+    std::vector<std::string> sset;
+    if (!faces.empty()) sset.emplace_back("boundary");
+    ex_entity_id next = faces.empty() ? 1 : 2;
+    for (const FaceSet* fs : named) {
+      std::vector<int> elems, sides;
+      for (const auto& [h, f] : fs->faces) {
+        elems.push_back(position_of_hex[static_cast<std::size_t>(h)]);
+        sides.push_back(kExodusSideOfVtkFace[static_cast<std::size_t>(f)]);
+      }
+      check(api().ex_put_side_set_param(id, next, static_cast<int64_t>(elems.size()), 0), file,
+            fmt::format("writing side set {}", fs->name));
+      check(api().ex_put_side_set(id, next, elems.data(), sides.data()), file, fmt::format("writing side set {}", fs->name));
+      sset.push_back(fs->name);
+      ++next;
+    }
     NameList sset_names(sset);
-    check(api().ex_put_names(id, EX_SIDE_SET, sset_names.get()), file, "writing the side set name");
+    check(api().ex_put_names(id, EX_SIDE_SET, sset_names.get()), file, "writing the side set names");
   }
 
   std::vector<std::string> nset;

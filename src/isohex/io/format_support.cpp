@@ -51,6 +51,16 @@ void check_mesh_for_writing(const std::filesystem::path& file, const HexMesh& me
     for (const Index id : mesh.hexes[h])
       if (id < 0 || static_cast<std::size_t>(id) >= nv)
         fail(fmt::format("hex {} has vertex id {} out of range [0, {})", h, id, nv));
+  for (const FaceSet& fs : mesh.face_sets) {
+    const bool name_ok = !fs.name.empty() && fs.name.size() <= 32 && std::isalpha(static_cast<unsigned char>(fs.name[0])) &&
+                         std::all_of(fs.name.begin(), fs.name.end(), [](char c) {
+                           return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+                         });
+    if (!name_ok) fail(fmt::format("face set name '{}' is not letters, digits and '_' starting with a letter", fs.name));
+    for (const auto& [h, f] : fs.faces)
+      if (h < 0 || h >= mesh.num_hexes() || f < 0 || f > 5)
+        fail(fmt::format("face set {} has face ({}, {}) out of range", fs.name, h, f));
+  }
 }
 
 void TextOut::flush() {

@@ -12,6 +12,8 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace isohex {
@@ -21,12 +23,21 @@ using Vec3 = Eigen::Vector3d;    ///< a point in world coordinates
 using Hex = std::array<Index, 8>;   ///< 8 vertex ids in VTK order
 using Quad = std::array<Index, 4>;  ///< 4 vertex ids, counter-clockwise seen from outside
 
+/// A named set of hex faces: a side set (Exodus), an element-based surface (Abaqus). Faces are
+/// (hex, local face of kHexFaces). Made by cuts (sheets/cut.hpp) for each cut surface; only
+/// the writers read them, and algorithms that renumber hexes leave them to their caller.
+struct FaceSet {
+  std::string name;  ///< letters, digits and '_', starting with a letter (a valid Abaqus name)
+  std::vector<std::pair<Index, std::int8_t>> faces;
+};
+
 /// An all-hexahedral mesh.
 struct HexMesh {
   std::vector<Vec3> points;        ///< vertex coordinates
   std::vector<Hex> hexes;          ///< 8 vertex ids per hex, VTK order
   std::vector<Index> blocks;       ///< block (material) id per hex; empty means all block 0
   std::vector<std::uint8_t> fixed; ///< 1 = vertex held fixed by optimizers; empty means none
+  std::vector<FaceSet> face_sets;  ///< named face sets (side sets); empty means none
 
   [[nodiscard]] Index num_vertices() const { return static_cast<Index>(points.size()); }
   [[nodiscard]] Index num_hexes() const { return static_cast<Index>(hexes.size()); }

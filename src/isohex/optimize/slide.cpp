@@ -70,21 +70,32 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, const HexMesh& triangles_o
   face_.assign(n, -1);
   second_.assign(n, kNone);
   facing_.assign(n, Vec3::Zero());
+  facing2_.assign(n, Vec3::Zero());
   const auto valid = [&](std::int8_t k) {
     return k == kNone || (k == kTriangles && !tris_.empty()) || (k >= 0 && static_cast<std::size_t>(k) < surfaces_.size());
   };
   for (std::size_t v = 0; v < n; ++v) {
     Constraint c = constraints[v];
-    if (!valid(c.first) || !valid(c.second) || (c.first == kNone && c.second != kNone) || (c.first == c.second && c.first != kNone))
+    if (!valid(c.first) || !valid(c.second) || (c.first == kNone && c.second != kNone) ||
+        (c.first == c.second && c.first >= 0))
       throw Error(fmt::format("BoundarySurface: vertex {} has an invalid constraint ({}, {})", v, c.first, c.second));
-    if (c.first == kTriangles && c.second >= 0) std::swap(c.first, c.second);  // step in the level set's plane
+    if (c.first == kTriangles && c.second >= 0) {  // step in the level set's plane
+      std::swap(c.first, c.second);
+      std::swap(c.facing_first, c.facing_second);
+    }
     if (c.pinned) {
       role_[v] = static_cast<std::uint8_t>(Role::pinned);
     } else if (c.first != kNone) {
       role_[v] = static_cast<std::uint8_t>(Role::slides);
       target_[v] = c.first >= 0 ? c.first : -1;
       second_[v] = c.second;
-      if (c.second == kTriangles && v < mesh.points.size()) project(mesh.points[v], nullptr, &facing_[v]);
+      const bool two = c.first == kTriangles && c.second == kTriangles;
+      const Vec3& tri_facing = c.first == kTriangles ? c.facing_first : c.facing_second;
+      if (c.first == kTriangles || c.second == kTriangles) {
+        facing_[v] = tri_facing;
+        if (facing_[v].isZero() && v < mesh.points.size()) project(mesh.points[v], nullptr, &facing_[v]);
+      }
+      if (two) facing2_[v] = c.facing_second;
     }
   }
   sliding_ = pinned_ = 0;
@@ -97,25 +108,26 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, const HexMesh& triangles_o
 bool BoundarySurface::project_on_curve(Index v, Vec3& x, double len) const {
   // Gauss–Newton on the two levels: the least step that zeroes both linearisations. The
   // triangles' level is the signed distance to the plane of the nearest triangle facing the
-  // vertex's side, found again at every step.
-  const contour::LevelSet& a = surfaces_[static_cast<std::size_t>(target(v))];
-  const int b = second(v);
+  // vertex's side, found again at every step (two sides on a feature edge of the triangles).
   const double tri_tol = 1e-10 * (hi_ - lo_).norm();
+  const auto level = [&](int k, const Vec3& facing, const Vec3& q, Vec3& g, double& tol) {
+    if (k == kTriangles) {
+      const Vec3 foot = project(q, &facing, &g);
+      tol = tri_tol;
+      return g.dot(q - foot);
+    }
+    const contour::LevelSet& s = surfaces_[static_cast<std::size_t>(k)];
+    tol = s.tolerance();
+    return s.level(q, g);
+  };
+  const int a = target(v) >= 0 ? target(v) : kTriangles, b = second(v);
   Vec3 q = x;
   for (int it = 0; it < 60; ++it) {
     Vec3 ga, gb;
-    const double ra = a.level(q, ga);
-    double rb = 0, tol_b = 0;
-    if (b == kTriangles) {
-      const Vec3 foot = project(q, &facing_[v], &gb);
-      rb = gb.dot(q - foot);
-      tol_b = tri_tol;
-    } else {
-      const contour::LevelSet& s = surfaces_[static_cast<std::size_t>(b)];
-      rb = s.level(q, gb);
-      tol_b = s.tolerance();
-    }
-    if (std::abs(ra) <= a.tolerance() && std::abs(rb) <= tol_b) {
+    double tol_a = 0, tol_b = 0;
+    const double ra = level(a, facing_[v], q, ga, tol_a);
+    const double rb = level(b, b == kTriangles && a == kTriangles ? facing2_[v] : facing_[v], q, gb, tol_b);
+    if (std::abs(ra) <= tol_a && std::abs(rb) <= tol_b) {
       if (!((q - x).norm() <= len)) return false;
       x = q;
       return true;
@@ -177,7 +189,9 @@ std::size_t BoundarySurface::num_sliding_on(std::size_t k) const {
 bool BoundarySurface::tangent_normal(Index v, const Vec3& x, Vec3& n) const {
   if (on_triangles(v)) {
     n = Vec3::Zero();
-    project(x, nullptr, &n);
+    // On a feature edge (both constraints the triangles): the first face's normal; the step
+    // in its plane is put back on the edge.
+    project(x, second(v) == kTriangles ? &facing_[v] : nullptr, &n);
     return true;
   }
   if (target(v) < 0) return false;
@@ -190,12 +204,12 @@ bool BoundarySurface::tangent_normal(Index v, const Vec3& x, Vec3& n) const {
 }
 
 bool BoundarySurface::reproject(Index v, Vec3& x, const Vec3& n, double len) const {
+  if (second(v) != kNone) return project_on_curve(v, x, len);
   if (on_triangles(v)) {
     x = project(x, &n);
     return true;
   }
   if (target(v) < 0) return false;
-  if (second(v) != kNone) return project_on_curve(v, x, len);
   Vec3 p = x;
   const contour::LevelSet& s = surfaces_[target(v)];
   if (!(on_face(v) >= 0 ? s.project_on_face(p, len, surfaces_[on_face(v)]) : s.project(p, len))) return false;

@@ -57,7 +57,11 @@ class BoundarySurface {
   static constexpr std::int8_t kNone = -1, kTriangles = -2;
   struct Constraint {
     std::int8_t first = kNone, second = kNone;
-    bool pinned = false;  ///< held where it is (where three surfaces meet, a feature of the triangles)
+    bool pinned = false;  ///< held where it is (where three surfaces meet)
+    /// For kTriangles: the side of the triangles it keeps to (the triangles facing this way);
+    /// both kTriangles: a feature edge of the triangles, the two faces that meet there. Zero:
+    /// the nearest triangle's normal where the vertex is.
+    Vec3 facing_first = Vec3::Zero(), facing_second = Vec3::Zero();
   };
   /// Sliding by `constraints` (one per vertex of `mesh`, the mesh to optimise), with the boundary quads
   /// of `triangles_of` (e.g. the mesh before it was cut) as the kTriangles surface. A vertex
@@ -184,6 +188,7 @@ class BoundarySurface {
   std::vector<std::int8_t> face_;    // per vertex: the box face a rim vertex keeps to, or −1
   std::vector<std::int8_t> second_;  // per vertex (or empty): a Constraint's second surface
   std::vector<Vec3> facing_;         // per vertex (or empty): the side of the triangles it keeps to
+  std::vector<Vec3> facing2_;        // ... and of the second face, on a feature edge (both triangles)
   std::vector<std::uint8_t> unpinned_;  // per vertex (or empty): loosen() released it from pinned
   std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
   double band_ = 0;

@@ -329,16 +329,15 @@ std::vector<std::uint8_t> near_hexes(const HexMesh& m, const Incidence& inc, con
   return near;
 }
 
-// The optimisers' constraint for a vertex: at most two things to keep to, and one of them a
-// cut (the triangles' two faces of a feature edge are not a curve BoundarySurface follows).
+// The optimisers' constraint for a vertex: one or two things to keep to (two faces of the
+// input's triangles: a feature edge); three or more pin it.
 BoundarySurface::Constraint constraint_of(const Keeps& k) {
   BoundarySurface::Constraint c;
   if (k.empty()) return c;
   const auto id = [](const Keep& e) { return e.surface >= 0 ? static_cast<std::int8_t>(e.surface) : BoundarySurface::kTriangles; };
-  if (k.size() == 1) {
-    c.first = id(k[0]);
-  } else if (k.size() == 2 && (k[0].surface >= 0 || k[1].surface >= 0)) {
-    c.first = id(k[0]), c.second = id(k[1]);
+  if (k.size() <= 2) {
+    c.first = id(k[0]), c.facing_first = k[0].facing;
+    if (k.size() == 2) c.second = id(k[1]), c.facing_second = k[1].facing;
   } else {
     c.pinned = true;
   }
@@ -518,25 +517,44 @@ CutResult cut(const HexMesh& input, const std::vector<Shape>& surfaces, const Cu
   for (const Shape& s : surfaces) res.steps.push_back(c.cut_once(s));
 
   // Per cut: its quads (all four vertices on it) and how far its vertices are from it.
-  const HexMesh& m = res.mesh;
   res.surface_quads.resize(surfaces.size());
   res.max_distance.assign(surfaces.size(), 0.0);
-  for (const QuadFace& q : build_quads(m))
-    for (std::size_t j = 0; j < surfaces.size(); ++j)
-      if (std::all_of(q.vertices.begin(), q.vertices.end(),
-                      [&](Index v) { return on_surface(c.keeps[v], c.first_cut + static_cast<int>(j)); }))
-        res.surface_quads[j].push_back(q.vertices);
-  for (Index v = 0; v < m.num_vertices(); ++v)
+  // ... and as face sets for the solvers: "cutJ" (the faces on a surface that is boundary) or
+  // "cutJ_inside" / "cutJ_outside" (the two sides of an interface), J from 1.
+  std::vector<std::array<FaceSet, 3>> sets(surfaces.size());
+  for (const QuadFace& q : build_quads(res.mesh))
+    for (std::size_t j = 0; j < surfaces.size(); ++j) {
+      if (!std::all_of(q.vertices.begin(), q.vertices.end(),
+                       [&](Index v) { return on_surface(c.keeps[v], c.first_cut + static_cast<int>(j)); }))
+        continue;
+      res.surface_quads[j].push_back(q.vertices);
+      if (q.is_boundary()) {
+        sets[j][0].faces.push_back({q.hex[0], q.local[0]});
+        continue;
+      }
+      const Index in = evaluate(surfaces[j], centroid(res.mesh, q.hex[0])) < 0 ? 0 : 1;
+      sets[j][1].faces.push_back({q.hex[in], q.local[in]});
+      sets[j][2].faces.push_back({q.hex[1 - in], q.local[1 - in]});
+    }
+  for (std::size_t j = 0; j < surfaces.size(); ++j)
+    for (int k = 0; k < 3; ++k) {
+      FaceSet& fs = sets[j][static_cast<std::size_t>(k)];
+      if (fs.faces.empty()) continue;
+      std::sort(fs.faces.begin(), fs.faces.end());
+      fs.name = fmt::format("cut{}{}", j + 1, k == 0 ? "" : k == 1 ? "_inside" : "_outside");
+      res.mesh.face_sets.push_back(std::move(fs));
+    }
+  for (Index v = 0; v < res.mesh.num_vertices(); ++v)
     for (const Keep& k : c.keeps[v])
       if (k.surface >= c.first_cut) {
         const auto s = static_cast<std::size_t>(k.surface);
-        const double d = std::abs(c.levels[s].level(m.points[v])) / scale;
+        const double d = std::abs(c.levels[s].level(res.mesh.points[v])) / scale;
         double& worst = res.max_distance[s - static_cast<std::size_t>(c.first_cut)];
         worst = std::max(worst, d);
       }
   // What the optimisers after the cut need to keep every vertex where it lies.
   res.surfaces = c.levels;
-  res.constraints.resize(m.points.size());
+  res.constraints.resize(res.mesh.points.size());
   for (std::size_t v = 0; v < res.constraints.size(); ++v) res.constraints[v] = constraint_of(c.keeps[v]);
   return res;
 }

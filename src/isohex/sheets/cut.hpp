@@ -90,6 +90,9 @@ struct CutStep {
 
 /// The result.
 struct CutResult {
+  /// The cut mesh; its face_sets hold each cut's faces: "cutJ" where the surface is boundary (a
+  /// side dropped), "cutJ_inside" and "cutJ_outside" (the faces of the hexes on either side)
+  /// where it is an interface, J = 1, 2, ... in the order of the surfaces.
   HexMesh mesh;
   std::vector<CutStep> steps;
   /// Per cut surface: the quads on it in `mesh` (each once; for `both`, oriented from the inside
