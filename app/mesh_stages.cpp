@@ -518,8 +518,18 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
   std::size_t reattached = 0;
   double band = slide.band;  // wider if the rounds ran again (release_rounds())
   bool poor_left = false;
-  const nlohmann::json released =
+  nlohmann::json released =
       rounds_follow ? release_rounds(mesh, *surface, band, o, &reattached, &poor_left) : nlohmann::json::array();
+  if (rounds_follow && slide.cut && poor_left) {
+    // The last resort after cuts: the crease vertices (a cut on the isosurface) of hexes still
+    // below 0.2 leave the isosurface for the band, staying on the cut. Not sooner: the crease
+    // is the surfaces' exact curve wherever the rounds did without (cthead's y = 110 plane).
+    surface->set_release_creases(true);
+    fmt::print("boundary: hexes below 0.2 after the rounds; releasing the cuts' crease vertices too\n");
+    std::size_t more = 0;
+    released.push_back({{"creases_released", true}, {"rounds", release_rounds(mesh, *surface, band, o, &more, &poor_left)}});
+    reattached += more;
+  }
   if (rounds_follow && released.empty() && poor_left) {
     // No round ran (no hex below 0.2 by rank has a boundary vertex to release within reach):
     // the end game the first run left to them, here, the boundary on its surfaces.

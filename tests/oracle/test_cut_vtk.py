@@ -12,9 +12,12 @@
   y = 110 behind the face (`isohex mesh --cut`), both sides kept: two blocks, none below 0.2 by
   VTK, the blocks' shared points on the plane (1e-9) and the boundary points on the plane (the
   crease; those on the box's faces aside) on the isosurface to 1e-6 of the value range (trilinear interpolation of the raw volume here,
-  by numpy).
+  by numpy). At y = 70 (through the nasal cavities' knife edges) none below 0.2 either: the
+  crease vertices there are released into the band about the skin as a last resort, and stay
+  on the plane.
 Exits non-zero on any failure.
 """
+import json
 import os
 import subprocess
 import sys
@@ -183,6 +186,19 @@ def test_cthead(cli, data, tmp):
     check(len(on_plane) > 50 and level.max() <= 1e-6,
           f"cthead cut: {len(on_plane)} crease points, |f - 600| / range at most {level.max():.2g} (1e-6 allowed)")
     print(f"cthead cut: {len(on_plane)} crease points, |f - 600| / range at most {level.max():.2g}")
+    # y = 70 runs through the nasal cavities' knife edges: the rounds' last resort releases crease
+    # vertices about the skin (within the band of 0.3 cells), still exactly on the plane.
+    out70, js70 = os.path.join(tmp, "head_cut70.vtu"), os.path.join(tmp, "head_cut70.json")
+    rc, log = run([cli, "mesh", raw, "--dims", "256", "256", "113", "--type", "i16", "--endian", "big", "--spacing", "1",
+                   "1", "2", "--iso", "600", "--cell-size", "4", "--cut", "plane(0,70,0, 0,1,0)", "-o", out70, "--json", js70])
+    if not check(rc == 0, f"isohex mesh --cut y = 70 (cthead) exit {rc}: {log[-800:]}"):
+        return
+    sj = hex_quality(read_vtu(out70))
+    check(int((sj < 0.2).sum()) == 0, f"cthead cut at y = 70: {(sj < 0.2).sum()} hexes below 0.2 by VTK (min {sj.min():.4f})")
+    j = json.load(open(js70))
+    check(j["cutting"]["cuts"][0]["final_max_relative_distance"] <= 1e-9,
+          f"cthead cut at y = 70: cut vertices within {j['cutting']['cuts'][0]['final_max_relative_distance']:.3g} of the plane")
+    check(j["released_max_distance"] <= 0.3 * 4 * (1 + 1e-3), f"cthead cut at y = 70: released within {j['released_max_distance']:.3g}")
 
 
 def main():

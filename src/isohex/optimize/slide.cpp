@@ -227,12 +227,16 @@ bool BoundarySurface::in_domain(const Vec3& x) const {
 
 std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band) {
   std::size_t n = 0;
-  // Exact surfaces stay exact: a vertex on a shape (a cut), or on its curve with another
-  // surface, is not released, nor a corner where constraints pinned it.
+  // Exact surfaces stay exact: a vertex on a shape (a cut surface) is not released, nor a corner
+  // where constraints pinned it; one on a cut's crease with an isosurface only after
+  // set_release_creases(), about the isosurface while it stays on the cut (band_clamp()).
   const auto on_shape = [&](int k) { return k >= 0 && surfaces_[static_cast<std::size_t>(k)].shape() != nullptr; };
   for (Index v : vertices) {
     if (v < 0 || static_cast<std::size_t>(v) >= role_.size()) continue;
-    if (on_shape(target(v)) || on_shape(second(v))) continue;
+    if (on_shape(target(v))) continue;
+    if (on_shape(second(v)) &&
+        !(release_creases_ && target(v) >= 0 && surfaces_[static_cast<std::size_t>(target(v))].field()))
+      continue;
     if (role_[v] == static_cast<std::uint8_t>(Role::pinned) && !second_.empty()) continue;
     if (role_[v] == static_cast<std::uint8_t>(Role::pinned)) {
       // On the input's own triangles, a feature vertex is released about them; on level sets a
@@ -305,8 +309,14 @@ bool BoundarySurface::band_clamp(Index v, Vec3& x, double /*len*/) const {
   // The projection follows the gradient, not the straight line to the nearest point, so the
   // foot seen from the clamped point can differ a little: a few rounds settle it, and a step
   // whose foot does not settle is refused.
+  // A crease vertex released about its isosurface keeps to its cut (a shape): onto it first,
+  // and again after each step to the band's edge, until both hold.
+  const contour::LevelSet* cut =
+      second(v) >= 0 && surfaces_[static_cast<std::size_t>(second(v))].shape() ? &surfaces_[static_cast<std::size_t>(second(v))]
+                                                                               : nullptr;
+  if (cut && !cut->project(x, kFootReach * band_)) return false;
   Vec3 foot;
-  for (int round = 0; round < 5; ++round) {
+  for (int round = 0; round < (cut ? 20 : 5); ++round) {
     // The same reaches as offset(): a wider first reach (a long step) could find another foot
     // than offset() later does from the same point, and the band would not hold as measured.
     if (!foot_point(v, x, kFootReach * band_, foot)) return false;
@@ -315,6 +325,7 @@ bool BoundarySurface::band_clamp(Index v, Vec3& x, double /*len*/) const {
     if (!(dn > band_ * (1 + 1e-6))) return true;
     x = foot + d * (band_ / dn);
     clamp();
+    if (cut && !cut->project(x, kFootReach * band_)) return false;
   }
   return false;
 }

@@ -101,8 +101,13 @@ class BoundarySurface {
   /// Pinned vertices are released too where they have a surface to keep near: about the
   /// input's triangles (feature vertices), or about the isosurface they lie on (a rim, where it
   /// meets the domain box). Not released: vertices on a shape (a cut surface) or on its curve
-  /// with another surface, and the pinned ones of the Constraint form (corners).
+  /// with another surface, and the pinned ones of the Constraint form (corners); after
+  /// set_release_creases(true), a vertex on a cut's curve with an isosurface is released about
+  /// the isosurface and stays on the cut.
   std::size_t loosen(const HexMesh& mesh, const std::vector<Index>& vertices, double band);
+  /// Lets loosen() release the vertices where a cut meets an isosurface (the last resort of
+  /// `isohex mesh --cut`: their hexes stayed below 0.2 with the crease on the isosurface).
+  void set_release_creases(bool on) { release_creases_ = on; }
   /// Where loose vertex v at x would sit on its target (`len`: the local edge length): the
   /// nearest triangle point, a rim vertex's point on its curve, else its foot point on its
   /// level set. False where there is none.
@@ -192,6 +197,7 @@ class BoundarySurface {
   std::vector<std::uint8_t> unpinned_;  // per vertex (or empty): loosen() released it from pinned
   std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
   double band_ = 0;
+  bool release_creases_ = false;
   Aabb domain_{Vec3::Zero(), Vec3::Zero()};
   bool has_domain_ = false;
   std::vector<std::array<Vec3, 3>> tris_;

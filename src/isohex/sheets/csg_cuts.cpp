@@ -48,6 +48,27 @@ bool is_face_of(const Shape& s, const Aabb& box) {
   return false;
 }
 
+// The box the grid fills: the shape's bounds, except that a face of them that no plane of the
+// shape lies in is where a curved surface touches it (a sphere's bounding box): the grid reaches
+// a tenth of the box past it, or the hexes there would be slivers.
+Aabb grid_box(const Shape& shape) {
+  const Aabb tight = bounds(shape);
+  if (!tight.is_finite()) throw Error("mesh by cuts: the shape is unbounded (a plane not intersected with a bounded shape)");
+  if (tight.is_empty()) throw Error("mesh by cuts: the shape is empty (an intersection of disjoint bounding boxes)");
+  Aabb box = tight;
+  std::vector<Shape> all;
+  collect(shape, 0, all);
+  const double margin = 0.1 * (tight.hi - tight.lo).maxCoeff();
+  for (int f = 0; f < 6; ++f) {
+    const bool planar = std::any_of(all.begin(), all.end(), [&](const Shape& p) {
+      const auto* hs = std::get_if<HalfSpace>(&p.node);
+      return hs && is_face_of(p, tight) && hs->normal[f / 2] != 0 && (hs->normal[f / 2] > 0) == (f % 2 == 1);
+    });
+    if (!planar) (f % 2 ? box.hi : box.lo)[f / 2] += (f % 2 ? margin : -margin);
+  }
+  return box;
+}
+
 }  // namespace
 
 std::vector<Shape> smooth_pieces(const Shape& shape, double reach) {
@@ -57,23 +78,7 @@ std::vector<Shape> smooth_pieces(const Shape& shape, double reach) {
 }
 
 CsgMeshResult mesh_by_cuts(const Shape& shape, const CsgMeshOptions& options) {
-  Aabb box = bounds(shape);
-  if (!box.is_finite()) throw Error("mesh by cuts: the shape is unbounded (a plane not intersected with a bounded shape)");
-  if (box.is_empty()) throw Error("mesh by cuts: the shape is empty (an intersection of disjoint bounding boxes)");
-  // A face of the bounds that no plane of the shape lies in is where a curved surface touches
-  // it (a sphere's bounding box): the grid reaches past it, or the hexes there would be slivers.
-  {
-    const std::vector<Shape> all = smooth_pieces(shape, 0);
-    const Aabb tight = box;
-    const double margin = 0.1 * (tight.hi - tight.lo).maxCoeff();
-    for (int f = 0; f < 6; ++f) {
-      const bool planar = std::any_of(all.begin(), all.end(), [&](const Shape& p) {
-        const auto* hs = std::get_if<HalfSpace>(&p.node);
-        return hs && is_face_of(p, tight) && hs->normal[f / 2] != 0 && (hs->normal[f / 2] > 0) == (f % 2 == 1);
-      });
-      if (!planar) (f % 2 ? box.hi : box.lo)[f / 2] += (f % 2 ? margin : -margin);
-    }
-  }
+  const Aabb box = grid_box(shape);
   const Vec3 size = box.hi - box.lo;
   double h = options.cell_size;
   if (!(h > 0)) {

@@ -4,7 +4,8 @@
 /// --features sheets`).
 ///
 /// A structured grid fills the shape's bounding box (its faces are the faces of a box in the
-/// shape, exactly); each smooth piece of the primitives' surfaces then cuts it, both sides
+/// shape, exactly; a face that no plane of the shape lies in, where a curved surface touches
+/// the bounds, is pushed out by a tenth of the box); each smooth piece of the primitives' surfaces then cuts it, both sides
 /// kept (cut.hpp): a sphere, a torus or a plane is one piece, a box six planes, a capped
 /// cylinder its side (the cylinder lengthened past the grid) and its two cap planes. Every
 /// piece becomes a conforming surface of the mesh, and where two meet the mesh has a string of
