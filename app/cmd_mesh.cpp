@@ -288,23 +288,7 @@ void run(const Args& a) {
                          {"worst moves", optimisation["worst"]["moves"]}};
   }
 
-  if (!cut_shapes.empty()) {
-    // Where the optimisation left the cut surfaces' vertices (each slid on its surface).
-    for (std::size_t j = 0; j < cut_shapes.size(); ++j) {
-      const contour::LevelSet& s = cut.surfaces[static_cast<std::size_t>(cut.first_cut) + j];
-      double far = 0;
-      std::size_t n = 0;
-      for (std::size_t v = 0; v < cut.constraints.size(); ++v) {
-        const BoundarySurface::Constraint& c = cut.constraints[v];
-        if (c.first != cut.first_cut + static_cast<int>(j) && c.second != cut.first_cut + static_cast<int>(j)) continue;
-        far = std::max(far, std::abs(s.level(out.mesh.points[v])) / s.scale());
-        ++n;
-      }
-      fmt::print("cut {}: {} vertices on it after the optimisation, within {:.3g} of it (relative to the mesh's size)\n",
-                 j + 1, n, far);
-      cutting["cuts"][j]["final_max_relative_distance"] = far;
-    }
-  }
+  if (!cut_shapes.empty()) report_cut_distances(cut, out.mesh, cutting);
   release_free_memory();
   t = Clock::now();
   const ValidationReport check = validate(out.mesh);

@@ -68,8 +68,8 @@ nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, 
   CutOptions co;
   co.keep = keep;
   co.boundary = region.surfaces;
-  stage.first_cut = static_cast<int>(region.surfaces.size()) + 6;
   for (const contour::LevelSet& f : contour::box_faces(region.domain)) co.boundary.push_back(f);
+  stage.first_cut = static_cast<int>(co.boundary.size());
   co.feature_degrees = 180;  // a scan's boundary has no features: its vertices are on level sets
   CutResult r = cut(mesh, shapes, co);
   nlohmann::json steps = nlohmann::json::array();
@@ -101,6 +101,23 @@ nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, 
   stage.constraints = std::move(r.constraints);
   mesh = std::move(r.mesh);
   return {{"keep", cut_keep_name(keep)}, {"cuts", steps}};
+}
+
+void report_cut_distances(const CutStage& stage, const HexMesh& mesh, nlohmann::json& cutting) {
+  for (std::size_t j = 0; j + static_cast<std::size_t>(stage.first_cut) < stage.surfaces.size(); ++j) {
+    const int id = stage.first_cut + static_cast<int>(j);
+    const contour::LevelSet& s = stage.surfaces[static_cast<std::size_t>(id)];
+    double far = 0;
+    std::size_t n = 0;
+    for (std::size_t v = 0; v < stage.constraints.size(); ++v)
+      if (stage.constraints[v].first == id || stage.constraints[v].second == id) {
+        far = std::max(far, std::abs(s.level(mesh.points[v])) / s.scale());
+        ++n;
+      }
+    fmt::print("cut {}: {} vertices on it after the optimisation, within {:.3g} of it (relative to the mesh's size)\n",
+               j + 1, n, far);
+    cutting["cuts"][j]["final_max_relative_distance"] = far;
+  }
 }
 
 nlohmann::json refine_stage(const contour::Region& region, contour::ExtractResult& extracted, double tolerance,

@@ -85,6 +85,10 @@ nlohmann::json cut_step_json(const CutStep& step, double max_distance);
 nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const contour::Region& region,
                          const std::vector<Shape>& shapes, CutKeep keep, bool terminal, CutStage& stage);
 
+/// Where the optimisation left each cut's vertices: the largest |L| / scale, printed and put in
+/// `cutting["cuts"][j]["final_max_relative_distance"]`.
+void report_cut_distances(const CutStage& stage, const HexMesh& mesh, nlohmann::json& cutting);
+
 /// How `isohex mesh`'s optimisation treats the boundary: fixed (null region), or sliding
 /// (`--boundary slide`): each boundary vertex on its own surface, the one `vertex_place` names
 /// among region->surfaces. A vertex on one face of the domain box (an --outer box, or the

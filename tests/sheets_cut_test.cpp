@@ -64,6 +64,16 @@ Vec3 unit_normal(const HexMesh& m, const Quad& q) {
   return (m.points[q[2]] - m.points[q[0]]).cross(m.points[q[3]] - m.points[q[1]]).normalized();
 }
 
+// Per boundary edge (smaller id, larger id): the unit normals of its boundary quads.
+std::map<std::pair<Index, Index>, std::vector<Vec3>> boundary_edge_normals(const HexMesh& m) {
+  std::map<std::pair<Index, Index>, std::vector<Vec3>> out;
+  for (const Quad& q : boundary_quads(m)) {
+    const Vec3 qn = unit_normal(m, q);
+    for (int i = 0; i < 4; ++i) out[{std::min(q[i], q[(i + 1) % 4]), std::max(q[i], q[(i + 1) % 4])}].push_back(qn);
+  }
+  return out;
+}
+
 }  // namespace
 
 // The paper's figures 6 and 7: a cube carved by three spheres that overlap each other and cross
@@ -167,13 +177,8 @@ TEST(Cut, PlaneKeepsBothSidesConforming) {
   CutOptions in;
   in.keep = CutKeep::inside;
   const HexMesh half = cut(box_mesh(12, 12, 12, Vec3::Zero(), Vec3(2, 2, 2)), {Shape::plane(p0, Vec3(1, 0.3, 0.2))}, in).mesh;
-  std::map<std::pair<Index, Index>, std::vector<Vec3>> edge_normals;
-  for (const Quad& q : boundary_quads(half)) {
-    const Vec3 qn = unit_normal(half, q);
-    for (int i = 0; i < 4; ++i) edge_normals[{std::min(q[i], q[(i + 1) % 4]), std::max(q[i], q[(i + 1) % 4])}].push_back(qn);
-  }
   std::size_t creases = 0;
-  for (const auto& [e, ns] : edge_normals) {
+  for (const auto& [e, ns] : boundary_edge_normals(half)) {
     ASSERT_EQ(ns.size(), 2u);
     const bool a_on = std::abs(ns[0].dot(n) - 1) < 1e-6, b_on = std::abs(ns[1].dot(n) - 1) < 1e-6;
     if (a_on == b_on) continue;
@@ -266,6 +271,8 @@ TEST(Cut, ShapeLevelSet) {
   Vec3 far(9, 9, 9);
   EXPECT_FALSE(s.project(far, 0.1));  // beyond the reach
   EXPECT_NE(s.describe().find("sphere(1, 2, 3, 0.5)"), std::string::npos);
+  const Vec3 r = s.root(Vec3(1, 2, 3), Vec3(2, 2, 3));  // from inside to outside
+  EXPECT_NEAR(r.x(), 1.5, 1e-9);
 }
 
 TEST(Cut, CommandLine) {
@@ -277,8 +284,11 @@ TEST(Cut, CommandLine) {
                     &out),
             0)
       << out;
-  EXPECT_NE(out.find("below 0.2: 0"), std::string::npos) << out;
-  EXPECT_NE(out.find("0 of "), std::string::npos) << out;
+  const auto j = nlohmann::json::parse(io::read_file(dir / "cut.json"));
+  EXPECT_EQ(j["quality"]["below_0.2"].get<int>(), 0);
+  EXPECT_EQ(j["validity"]["not_valid_inside"].get<int>(), 0);
+  EXPECT_EQ(j["cuts"][0]["sheet_hexes"].get<int>(), j["cuts"][0]["surface_quads"].get<int>());  // one sheet (one side kept)
+  EXPECT_LE(j["cuts"][0]["max_relative_distance"].get<double>(), 1e-9);
   EXPECT_EQ(run_cli("quality " + quote(dir / "carved.vtu"), &out), 0) << out;
   // The cut's faces as an Abaqus surface of their own, and an Exodus side set.
   ASSERT_EQ(run_cli("cut " + quote(dir / "cube8.vtu") + " -o " + quote(dir / "carved.inp") +
@@ -306,13 +316,8 @@ namespace {
 
 // The boundary edges whose two quads' normals differ by more than `degrees`: (edge, angle).
 std::vector<double> crease_angles(const HexMesh& m, double degrees) {
-  std::map<std::pair<Index, Index>, std::vector<Vec3>> edge_normals;
-  for (const Quad& q : boundary_quads(m)) {
-    const Vec3 qn = unit_normal(m, q);
-    for (int i = 0; i < 4; ++i) edge_normals[{std::min(q[i], q[(i + 1) % 4]), std::max(q[i], q[(i + 1) % 4])}].push_back(qn);
-  }
   std::vector<double> out;
-  for (const auto& [e, ns] : edge_normals) {
+  for (const auto& [e, ns] : boundary_edge_normals(m)) {
     if (ns.size() != 2) continue;
     const double a = std::acos(std::clamp(ns[0].dot(ns[1]), -1.0, 1.0)) * 180 / std::numbers::pi;
     if (a > degrees) out.push_back(a);

@@ -51,6 +51,12 @@ struct HexMesh {
     for (int i = 0; i < 8; ++i) c[i] = points[hexes[h][i]];
     return c;
   }
+  /// The mean of hex `h`'s corners.
+  [[nodiscard]] Vec3 centroid(Index h) const {
+    Vec3 c = Vec3::Zero();
+    for (Index v : hexes[h]) c += points[v];
+    return c / 8;
+  }
 };
 
 /// The 6 faces of a hex in VTK's order, each listed counter-clockwise seen from outside

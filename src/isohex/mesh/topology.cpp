@@ -182,4 +182,35 @@ std::vector<std::uint8_t> boundary_vertex_mask(const HexMesh& mesh) {
   return mask;
 }
 
+HexMesh keep_hexes(const HexMesh& mesh, const std::vector<std::uint8_t>& keep, std::vector<Index>* vertex_id,
+                   std::vector<Index>* hex_id) {
+  std::vector<Index> vid(mesh.points.size(), -1), hid(mesh.hexes.size(), -1);
+  HexMesh out;
+  for (Index h = 0; h < mesh.num_hexes(); ++h) {
+    if (!keep[h]) continue;
+    hid[h] = out.num_hexes();
+    Hex hx = mesh.hexes[h];
+    for (Index& v : hx) {
+      if (vid[v] < 0) vid[v] = out.num_vertices(), out.points.push_back(mesh.points[v]);
+      v = vid[v];
+    }
+    out.hexes.push_back(hx);
+    if (mesh.has_blocks()) out.blocks.push_back(mesh.blocks[h]);
+  }
+  if (mesh.has_fixed()) {
+    out.fixed.assign(out.points.size(), 0);
+    for (std::size_t v = 0; v < vid.size(); ++v)
+      if (vid[v] >= 0) out.fixed[static_cast<std::size_t>(vid[v])] = mesh.fixed[v];
+  }
+  for (const FaceSet& fs : mesh.face_sets) {
+    FaceSet kept{fs.name, {}};
+    for (const auto& [h, f] : fs.faces)
+      if (hid[h] >= 0) kept.faces.push_back({hid[h], f});
+    if (!kept.faces.empty()) out.face_sets.push_back(std::move(kept));
+  }
+  if (vertex_id) *vertex_id = std::move(vid);
+  if (hex_id) *hex_id = std::move(hid);
+  return out;
+}
+
 }  // namespace isohex

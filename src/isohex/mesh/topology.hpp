@@ -72,4 +72,11 @@ Incidence vertex_cells(const std::vector<std::array<Index, N>>& cells, Index num
 /// Vertices on the boundary (1) or not (0).
 std::vector<std::uint8_t> boundary_vertex_mask(const HexMesh& mesh);
 
+/// The hexes flagged in `keep` (in order) and the vertices they use (numbered in the order the
+/// kept hexes first use them), with their blocks, fixed flags and the faces of the face sets
+/// that are on kept hexes (a set left empty is dropped). `vertex_id` / `hex_id` (may be null)
+/// receive each old vertex's / hex's new id, or -1.
+HexMesh keep_hexes(const HexMesh& mesh, const std::vector<std::uint8_t>& keep, std::vector<Index>* vertex_id = nullptr,
+                   std::vector<Index>* hex_id = nullptr);
+
 }  // namespace isohex

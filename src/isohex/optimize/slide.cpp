@@ -83,19 +83,19 @@ BoundarySurface::BoundarySurface(const HexMesh& mesh, const HexMesh& triangles_o
       std::swap(c.first, c.second);
       std::swap(c.facing_first, c.facing_second);
     }
+    if (c.first == kTriangles && c.second == kTriangles && (c.facing_first.isZero() || c.facing_second.isZero()))
+      throw Error(fmt::format("BoundarySurface: vertex {} on a feature edge needs the facings of both faces", v));
     if (c.pinned) {
       role_[v] = static_cast<std::uint8_t>(Role::pinned);
     } else if (c.first != kNone) {
       role_[v] = static_cast<std::uint8_t>(Role::slides);
       target_[v] = c.first >= 0 ? c.first : -1;
       second_[v] = c.second;
-      const bool two = c.first == kTriangles && c.second == kTriangles;
-      const Vec3& tri_facing = c.first == kTriangles ? c.facing_first : c.facing_second;
-      if (c.first == kTriangles || c.second == kTriangles) {
-        facing_[v] = tri_facing;
-        if (facing_[v].isZero() && v < mesh.points.size()) project(mesh.points[v], nullptr, &facing_[v]);
-      }
-      if (two) facing2_[v] = c.facing_second;
+      // After the swap the triangles are the first constraint, or the second beside a level set.
+      if (c.first == kTriangles) facing_[v] = c.facing_first, facing2_[v] = c.facing_second;
+      else if (c.second == kTriangles) facing_[v] = c.facing_second;
+      if (facing_[v].isZero() && (c.first == kTriangles || c.second == kTriangles) && v < mesh.points.size())
+        project(mesh.points[v], nullptr, &facing_[v]);
     }
   }
   sliding_ = pinned_ = 0;

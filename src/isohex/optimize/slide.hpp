@@ -58,9 +58,9 @@ class BoundarySurface {
   struct Constraint {
     std::int8_t first = kNone, second = kNone;
     bool pinned = false;  ///< held where it is (where three surfaces meet)
-    /// For kTriangles: the side of the triangles it keeps to (the triangles facing this way);
-    /// both kTriangles: a feature edge of the triangles, the two faces that meet there. Zero:
-    /// the nearest triangle's normal where the vertex is.
+    /// For kTriangles: the side of the triangles it keeps to (the triangles facing this way;
+    /// zero: the nearest triangle's normal where the vertex is). Both kTriangles: a feature edge
+    /// of the triangles, the two faces that meet there (both needed).
     Vec3 facing_first = Vec3::Zero(), facing_second = Vec3::Zero();
   };
   /// Sliding by `constraints` (one per vertex of `mesh`, the mesh to optimise), with the boundary quads

@@ -3,6 +3,7 @@
 
 #include "isohex/error.hpp"
 #include "isohex/mesh/generate.hpp"
+#include "isohex/mesh/topology.hpp"
 
 #include <fmt/format.h>
 
@@ -113,34 +114,15 @@ CsgMeshResult mesh_by_cuts(const Shape& shape, const CsgMeshOptions& options) {
   res.steps = cr.steps;
   res.max_distance = cr.max_distance;
 
-  // The hexes inside the shape, by their centroids; the vertices they use.
-  HexMesh& m = res.mesh;
-  std::vector<Index> id(cr.mesh.points.size(), -1), hex_id(cr.mesh.hexes.size(), -1);
-  for (Index h = 0; h < cr.mesh.num_hexes(); ++h) {
-    Vec3 c = Vec3::Zero();
-    for (Index v : cr.mesh.hexes[h]) c += cr.mesh.points[v];
-    if (!(evaluate(shape, c / 8.0) < 0)) {
-      ++res.dropped_hexes;
-      continue;
-    }
-    hex_id[static_cast<std::size_t>(h)] = m.num_hexes();
-    Hex hx = cr.mesh.hexes[h];
-    for (Index& v : hx) {
-      if (id[v] < 0) id[v] = static_cast<Index>(m.points.size()), m.points.push_back(cr.mesh.points[v]);
-      v = id[v];
-    }
-    m.hexes.push_back(hx);
-  }
-  if (m.hexes.empty()) throw Error("mesh by cuts: no hex of the grid is inside the shape; use a smaller cell size");
-  // The pieces' face sets, on the hexes kept (a side wholly dropped leaves an empty set out).
-  for (FaceSet fs : cr.mesh.face_sets) {
-    std::vector<std::pair<Index, std::int8_t>> kept;
-    for (const auto& [h, f] : fs.faces)
-      if (const Index k = hex_id[static_cast<std::size_t>(h)]; k >= 0) kept.push_back({k, f});
-    if (kept.empty()) continue;
-    fs.faces = std::move(kept);
-    m.face_sets.push_back(std::move(fs));
-  }
+  // The hexes inside the shape, by their centroids (no hex straddles a piece), with the
+  // pieces' faces on them; one solid, so no blocks.
+  std::vector<std::uint8_t> inside(cr.mesh.hexes.size());
+  for (Index h = 0; h < cr.mesh.num_hexes(); ++h) inside[h] = evaluate(shape, cr.mesh.centroid(h)) < 0;
+  res.dropped_hexes = static_cast<std::size_t>(std::count(inside.begin(), inside.end(), 0));
+  if (res.dropped_hexes == inside.size())
+    throw Error("mesh by cuts: no hex of the grid is inside the shape; use a smaller cell size");
+  res.mesh = keep_hexes(cr.mesh, inside);
+  res.mesh.blocks.clear();
   return res;
 }
 

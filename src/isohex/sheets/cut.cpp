@@ -74,19 +74,19 @@ bool on_surface(const Keeps& k, int surface) {
   return std::any_of(k.begin(), k.end(), [&](const Keep& e) { return e.surface == surface; });
 }
 
-bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& levels, const BoundarySurface& tris,
                   double tri_tol, double reach);
 
 // Alternating projections onto each of `keeps` in turn (slower than Newton steps, but they
 // settle where the triangles' planes change under the steps: a bumpy boundary).
-bool place_by_turns(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+bool place_by_turns(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& levels, const BoundarySurface& tris,
                     double tri_tol, double reach) {
   Vec3 q = x;
   for (int round = 0; round < 1000; ++round) {
     bool done = true;
     for (const Keep& k : keeps) {
       if (k.surface >= 0) {
-        const contour::LevelSet& s = cuts[static_cast<std::size_t>(k.surface)];
+        const contour::LevelSet& s = levels[static_cast<std::size_t>(k.surface)];
         done = done && std::abs(s.level(q)) <= s.tolerance();
       } else {
         done = done && (tris.project(q, &k.facing) - q).norm() <= tri_tol;
@@ -99,7 +99,7 @@ bool place_by_turns(Vec3& x, const Keeps& keeps, const std::vector<contour::Leve
     }
     for (const Keep& k : keeps) {
       if (k.surface >= 0) {
-        if (!cuts[static_cast<std::size_t>(k.surface)].project(q, reach)) return false;
+        if (!levels[static_cast<std::size_t>(k.surface)].project(q, reach)) return false;
       } else {
         q = tris.project(q, &k.facing);
       }
@@ -110,15 +110,15 @@ bool place_by_turns(Vec3& x, const Keeps& keeps, const std::vector<contour::Leve
 }
 
 // Moves x onto everything in `keeps` at once: Newton steps, each the least step that zeroes
-// the linearised levels (a cut's L, or the signed distance to the plane of the nearest
+// the linearised levels (a level set's L, or the signed distance to the plane of the nearest
 // triangle facing the keep's way), else by turns. False if neither settles within `reach`.
-bool place(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+bool place(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& levels, const BoundarySurface& tris,
            double tri_tol, double reach) {
-  if (place_newton(x, keeps, cuts, tris, tri_tol, reach)) return true;
-  return keeps.size() <= 3 && place_by_turns(x, keeps, cuts, tris, tri_tol, reach);
+  if (place_newton(x, keeps, levels, tris, tri_tol, reach)) return true;
+  return keeps.size() <= 3 && place_by_turns(x, keeps, levels, tris, tri_tol, reach);
 }
 
-bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& cuts, const BoundarySurface& tris,
+bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelSet>& levels, const BoundarySurface& tris,
                   double tri_tol, double reach) {
   const std::size_t k = std::min<std::size_t>(keeps.size(), 3);
   if (k == 0) return true;
@@ -131,7 +131,7 @@ bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelS
       Vec3 g;
       double tol = tri_tol;
       if (keeps[i].surface >= 0) {
-        const contour::LevelSet& s = cuts[static_cast<std::size_t>(keeps[i].surface)];
+        const contour::LevelSet& s = levels[static_cast<std::size_t>(keeps[i].surface)];
         r[i] = s.level(q, g);
         tol = s.tolerance();
       } else {
@@ -159,57 +159,61 @@ bool place_newton(Vec3& x, const Keeps& keeps, const std::vector<contour::LevelS
   return false;
 }
 
-Vec3 centroid(const HexMesh& m, Index h) {
-  Vec3 c = Vec3::Zero();
-  for (Index v : m.hexes[h]) c += m.points[v];
-  return c / 8.0;
-}
-
 // The sides of a cut (1 = inside) by the sign at each hex's centroid, or for a hex on the
 // boundary at the mean of its boundary faces' centres (the staircase then meets the boundary
-// where the surface does). Then, round after round until nothing changes: the two hexes on a
-// face of an earlier cut's surface take the side of the face's centre (an interface face on an
-// earlier surface would be on both: a face collapsed onto their curve), and a hex with four or
-// more faces towards the other side moves across.
-std::vector<std::uint8_t> classify(const HexMesh& m, const Shape& shape, const std::vector<Keeps>& keeps,
-                                   int first_cut, std::vector<std::uint8_t> side, const std::vector<std::uint8_t>& locked,
-                                   std::size_t& moved) {
-  const std::vector<std::array<Index, 6>> nb = face_neighbours(m);
-  if (side.empty()) {
-    side.resize(m.hexes.size());
-    for (Index h = 0; h < m.num_hexes(); ++h) {
-      Vec3 at = Vec3::Zero();
-      int faces = 0;
-      for (int f = 0; f < 6; ++f)
-        if (nb[h][f] < 0) {
-          for (Index v : face_vertices(m.hexes[h], f)) at += m.points[v];
-          ++faces;
-        }
-      side[h] = evaluate(shape, faces ? Vec3(at / (4.0 * faces)) : centroid(m, h)) < 0;
-    }
+// where the surface does).
+std::vector<std::uint8_t> first_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb, const Shape& shape) {
+  std::vector<std::uint8_t> side(m.hexes.size());
+  for (Index h = 0; h < m.num_hexes(); ++h) {
+    Vec3 at = Vec3::Zero();
+    int faces = 0;
+    for (int f = 0; f < 6; ++f)
+      if (nb[h][f] < 0) {
+        for (Index v : face_vertices(m.hexes[h], f)) at += m.points[v];
+        ++faces;
+      }
+    side[h] = evaluate(shape, faces ? Vec3(at / (4.0 * faces)) : m.centroid(h)) < 0;
   }
-  // The faces on an earlier cut's surface: all four vertices on one surface.
-  std::vector<std::pair<Index, Index>> on_earlier;  // (h, g), h < g
-  std::vector<std::uint8_t> face_side;
+  return side;
+}
+
+// The interior faces on an earlier cut's surface (all four vertices on it), as their two hexes,
+// with the side of the face's centre: both hexes must take it, or the face would be on the
+// interface too and collapse onto the curve of the two surfaces.
+struct EarlierFace {
+  Index h, g;
+  std::uint8_t side;
+};
+std::vector<EarlierFace> faces_on_earlier_cuts(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb,
+                                               const std::vector<Keeps>& keeps, int first_cut, const Shape& shape) {
+  std::vector<EarlierFace> out;
   for (Index h = 0; h < m.num_hexes(); ++h)
     for (int f = 0; f < 6; ++f) {
       const Index g = nb[h][f];
       if (g < h) continue;
       const Quad q = face_vertices(m.hexes[h], f);
-      bool shared = false;
-      for (const Keep& k : keeps[q[0]])
-        shared = shared || (k.surface >= first_cut && std::all_of(q.begin() + 1, q.end(), [&](Index v) { return on_surface(keeps[v], k.surface); }));
-      if (!shared) continue;
+      const bool on = std::any_of(keeps[q[0]].begin(), keeps[q[0]].end(), [&](const Keep& k) {
+        return k.surface >= first_cut &&
+               std::all_of(q.begin() + 1, q.end(), [&](Index v) { return on_surface(keeps[v], k.surface); });
+      });
+      if (!on) continue;
       Vec3 c = Vec3::Zero();
       for (Index v : q) c += m.points[v];
-      on_earlier.push_back({h, g});
-      face_side.push_back(evaluate(shape, c / 4.0) < 0);
+      out.push_back({h, g, static_cast<std::uint8_t>(evaluate(shape, c / 4.0) < 0)});
     }
+  return out;
+}
+
+// Round after round until nothing changes: the hexes on faces of earlier cuts take those faces'
+// sides, and a hex with four or more faces towards the other side moves across (`moved` counts
+// those); hexes flagged in `locked` stay.
+void settle_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb, const std::vector<EarlierFace>& earlier,
+                  const std::vector<std::uint8_t>& locked, std::vector<std::uint8_t>& side, std::size_t& moved) {
   for (int round = 0; round < 100; ++round) {
     bool changed = false;
-    for (std::size_t i = 0; i < on_earlier.size(); ++i)
-      for (Index h : {on_earlier[i].first, on_earlier[i].second})
-        if (side[h] != face_side[i] && !locked[h]) side[h] = face_side[i], changed = true;
+    for (const EarlierFace& e : earlier)
+      for (Index h : {e.h, e.g})
+        if (side[h] != e.side && !locked[h]) side[h] = e.side, changed = true;
     std::vector<Index> flip;
     for (Index h = 0; h < m.num_hexes(); ++h) {
       if (locked[h]) continue;
@@ -221,12 +225,11 @@ std::vector<std::uint8_t> classify(const HexMesh& m, const Shape& shape, const s
     moved += flip.size();
     if (!changed && flip.empty()) break;
   }
-  return side;
 }
 
 // Interface vertices on a surface (the boundary, an earlier cut) that the cut does not cross
 // near them: their hexes join one side (that of the vertex's sign, or of those of its hexes
-// already locked) and are locked there, so that the interface leaves them and classify() does
+// already locked) and are locked there, so that the interface leaves them and settle_sides() does
 // not move them back. Returns how many there were.
 std::size_t unreachable_to_one_side(const HexMesh& m, const Incidence& inc, const std::vector<std::uint8_t>& side,
                                     const std::vector<Keeps>& keeps, int cut_id, const std::vector<contour::LevelSet>& levels,
@@ -275,32 +278,25 @@ void pillow_side(HexMesh& m, std::vector<std::uint8_t>& side, std::vector<Keeps>
   m = std::move(p.mesh);
 }
 
-// Drops the hexes whose side is not `keep` and the vertices no hex uses.
+// Drops the hexes whose side is not `keep` and the vertices no hex uses; the per-hex and
+// per-vertex records follow.
 void drop_side(HexMesh& m, std::vector<std::uint8_t>& side, std::vector<Keeps>& keeps, std::vector<Index>& origin,
                std::vector<std::uint8_t>& sheet, std::uint8_t keep) {
-  std::vector<Index> new_id(m.points.size(), -1);
-  HexMesh out;
-  std::vector<std::uint8_t> out_side, out_sheet;
-  for (Index h = 0; h < m.num_hexes(); ++h) {
-    if (side[h] != keep) continue;
-    Hex hx = m.hexes[h];
-    for (Index& v : hx) {
-      if (new_id[v] < 0) new_id[v] = static_cast<Index>(out.points.size()), out.points.push_back(m.points[v]);
-      v = new_id[v];
-    }
-    out.hexes.push_back(hx);
-    if (m.has_blocks()) out.blocks.push_back(m.blocks[h]);
-    out_side.push_back(side[h]);
-    out_sheet.push_back(sheet[h]);
-  }
+  std::vector<std::uint8_t> kept(side.size());
+  for (std::size_t h = 0; h < side.size(); ++h) kept[h] = side[h] == keep;
+  std::vector<Index> vid, hid;
+  HexMesh out = keep_hexes(m, kept, &vid, &hid);
+  std::vector<std::uint8_t> out_side(out.hexes.size()), out_sheet(out.hexes.size());
+  for (std::size_t h = 0; h < hid.size(); ++h)
+    if (hid[h] >= 0) out_side[static_cast<std::size_t>(hid[h])] = side[h], out_sheet[static_cast<std::size_t>(hid[h])] = sheet[h];
   std::vector<Keeps> out_keeps(out.points.size());
   std::vector<Index> out_origin(out.points.size(), -1);
-  for (std::size_t v = 0; v < new_id.size(); ++v)
-    if (new_id[v] >= 0) {
-      out_keeps[static_cast<std::size_t>(new_id[v])] = std::move(keeps[v]);
-      if (origin[v] >= 0) out_origin[static_cast<std::size_t>(new_id[v])] = new_id[static_cast<std::size_t>(origin[v])];
-      if (m.has_fixed()) out.fixed.resize(out.points.size(), 0), out.fixed[static_cast<std::size_t>(new_id[v])] = m.fixed[v];
-    }
+  for (std::size_t v = 0; v < vid.size(); ++v) {
+    if (vid[v] < 0) continue;
+    const auto w = static_cast<std::size_t>(vid[v]);
+    out_keeps[w] = std::move(keeps[v]);
+    if (origin[v] >= 0) out_origin[w] = vid[static_cast<std::size_t>(origin[v])];
+  }
   m = std::move(out);
   side = std::move(out_side);
   sheet = std::move(out_sheet);
@@ -311,12 +307,10 @@ void drop_side(HexMesh& m, std::vector<std::uint8_t>& side, std::vector<Keeps>& 
 // 1 for the vertices within `rings` hex rings of the hexes flagged in `seed`.
 std::vector<std::uint8_t> near_hexes(const HexMesh& m, const Incidence& inc, const std::vector<std::uint8_t>& seed,
                                      int rings) {
-  std::vector<std::uint8_t> near(m.points.size(), 0), hex_in(m.hexes.size(), 0);
+  std::vector<std::uint8_t> near(m.points.size(), 0);
   for (Index h = 0; h < m.num_hexes(); ++h)
-    if (seed[h]) {
-      hex_in[h] = 1;
+    if (seed[h])
       for (Index v : m.hexes[h]) near[v] = 1;
-    }
   for (int r = 0; r < rings; ++r) {
     std::vector<std::uint8_t> next = near;
     for (Index v = 0; v < m.num_vertices(); ++v) {
@@ -363,17 +357,21 @@ struct Cutting {
     m = in;
   }
 
-  // The sides of cut j (1 = inside), the vertices the cut cannot reach sent to one side.
+  // The sides of the cut (1 = inside), settled, the vertices the cut cannot reach sent to one side.
   std::vector<std::uint8_t> sides(int cut_id, const Shape& shape, CutStep& step) const {
+    const std::vector<std::array<Index, 6>> nb = face_neighbours(m);
+    const std::vector<EarlierFace> earlier = faces_on_earlier_cuts(m, nb, keeps, first_cut, shape);
     std::vector<std::uint8_t> locked(m.hexes.size(), 0);
-    std::vector<std::uint8_t> side = classify(m, shape, keeps, first_cut, {}, locked, step.moved_across);
+    std::vector<std::uint8_t> side = first_sides(m, nb, shape);
+    settle_sides(m, nb, earlier, locked, side, step.moved_across);
     const Incidence inc = vertex_hexes(m);
     std::vector<std::uint8_t> next;
     for (int round = 0;
          round < 20 && unreachable_to_one_side(m, inc, side, keeps, cut_id, levels, tris, tri_tol, reach, next, locked) > 0;
          ++round) {
       for (std::size_t h = 0; h < side.size(); ++h) step.moved_across += next[h] != side[h];
-      side = classify(m, shape, keeps, first_cut, next, locked, step.moved_across);
+      side = std::move(next);
+      settle_sides(m, nb, earlier, locked, side, step.moved_across);
     }
     step.inside_hexes = static_cast<std::size_t>(std::count(side.begin(), side.end(), 1));
     step.outside_hexes = side.size() - step.inside_hexes;
@@ -436,7 +434,6 @@ struct Cutting {
       // an isosurface): it goes back there from where pillowing put it instead.
       m.points[v] = was;
       if (!place(m.points[v], keeps[v], levels, tris, tri_tol, reach) && step.unplaced++ == 0) first = m.points[v];
-
     }
     if (step.unplaced > 0)
       throw Error(fmt::format("cut: the surface {} cannot be reached from {} vertices of the new sheet: it is tangent to "
@@ -532,7 +529,7 @@ CutResult cut(const HexMesh& input, const std::vector<Shape>& surfaces, const Cu
         sets[j][0].faces.push_back({q.hex[0], q.local[0]});
         continue;
       }
-      const Index in = evaluate(surfaces[j], centroid(res.mesh, q.hex[0])) < 0 ? 0 : 1;
+      const Index in = evaluate(surfaces[j], res.mesh.centroid(q.hex[0])) < 0 ? 0 : 1;
       sets[j][1].faces.push_back({q.hex[in], q.local[in]});
       sets[j][2].faces.push_back({q.hex[1 - in], q.local[1 - in]});
     }

@@ -67,11 +67,7 @@ std::vector<std::uint8_t> select_hexes(const HexMesh& mesh, const std::string& s
   if (kind == "region" && colon != std::string::npos) {
     const Shape shape = parse_shape(arg);
     std::vector<std::uint8_t> set(mesh.hexes.size(), 0);
-    for (Index h = 0; h < mesh.num_hexes(); ++h) {
-      Vec3 c = Vec3::Zero();
-      for (Index v : mesh.hexes[h]) c += mesh.points[v];
-      set[h] = evaluate(shape, c / 8) < 0;
-    }
+    for (Index h = 0; h < mesh.num_hexes(); ++h) set[h] = evaluate(shape, mesh.centroid(h)) < 0;
     return set;
   }
   if (kind == "ids" && colon != std::string::npos) return from_ids_file(mesh, arg, context);
