@@ -1,8 +1,10 @@
-// isohex cut IN -o OUT --surface EXPR...: cut a hex mesh along implicit surfaces by sheet
-// insertion (§4.2), keeping both sides as blocks or one side.
+// isohex cut IN -o OUT --surface EXPR... [--volume FILE --iso V...]: cut a hex mesh along
+// implicit surfaces or isosurfaces by sheet insertion (§4.2), keeping both sides as blocks or
+// one side.
 #include "commands.hpp"
 #include "mesh_stages.hpp"
 
+#include "isohex/contour/iso_field.hpp"
 #include "isohex/error.hpp"
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/quality/hex_quality.hpp"
@@ -20,8 +22,10 @@ namespace isohex::cli {
 namespace {
 
 struct Args {
-  std::string input, output, json, keep = "both";
+  std::string input, output, json, keep = "both", volume, inside = "above";
   std::vector<std::string> surfaces;
+  std::vector<double> isos;
+  VolumeReadArgs read;
   double offset = CutOptions{}.offset, feature_angle = CutOptions{}.feature_degrees;
   int rings = CutOptions{}.rings;
   bool no_optimize = false, skip_non_hex = false;
@@ -39,9 +43,21 @@ void run(const Args& a) {
       throw Error(fmt::format("cut: --surface {} ('{}'): {}", i + 1, a.surfaces[i], e.what()));
     }
   }
+  if (a.surfaces.empty() && a.isos.empty()) throw Error("cut: give a cut surface: --surface EXPR or --volume FILE --iso V");
+  if (a.volume.empty() != a.isos.empty())
+    throw Error(a.volume.empty() ? "cut: --iso needs --volume FILE" : "cut: --volume needs --iso V (the isosurface to cut along)");
   if (!io::is_known_mesh_extension(a.output))
     throw Error(fmt::format("cut: {}: unknown mesh format (known: {})", a.output, io::kMeshExtensions));
+  const VolumeReadOptions read = a.read.options();
   const HexMesh mesh = load_mesh(a.input, a.skip_non_hex);
+  // The shapes first, then the isosurfaces, in the order given (the fields refer to `volume`,
+  // which outlives them and the result).
+  Volume volume;
+  if (!a.volume.empty()) volume = read_volume(a.volume, read);
+  std::vector<contour::LevelSet> surfaces;
+  for (const Shape& s : shapes) surfaces.emplace_back(std::make_shared<const Shape>(s), cut_scale(mesh, CutOptions{}));
+  for (const double iso : a.isos)
+    surfaces.emplace_back(std::make_shared<const IsoField>(volume, iso, *inside_from_name(a.inside)));
   CutOptions opt;
   opt.keep = *cut_keep_from_name(a.keep);
   opt.offset = a.offset;
@@ -49,8 +65,8 @@ void run(const Args& a) {
   opt.rings = a.rings;
   opt.optimize = !a.no_optimize;
   fmt::print("{}: {} hexes, {} vertices; {} cut(s), keep {}\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
-             shapes.size(), a.keep);
-  const CutResult r = cut(mesh, shapes, opt);
+             surfaces.size(), a.keep);
+  const CutResult r = cut(mesh, surfaces, opt);
 
   nlohmann::json report;
   report["input"] = a.input;
@@ -79,8 +95,9 @@ void run(const Args& a) {
              kQuestionableSJ, q.inverted + q.questionable + q.degenerate);
   fmt::print("{}\n", describe(validity));
   for (std::size_t i = 0; i < r.max_distance.size(); ++i)
-    fmt::print("cut {}: {} quads on the surface, vertices within {:.3g} of it (relative to the mesh's diagonal)\n",
-               i + 1, r.surface_quads[i].size(), r.max_distance[i]);
+    fmt::print("cut {}: {} quads on the surface, vertices within {:.3g} of it (relative to {})\n", i + 1,
+               r.surface_quads[i].size(), r.max_distance[i],
+               r.surfaces[r.surfaces.size() - r.steps.size() + i].field() ? "the volume's value range" : "the mesh's diagonal");
   report["quality"] = quality_json(q);
   report["validity"] = to_json(validity);
   report["hexes"] = r.mesh.num_hexes();
@@ -103,13 +120,21 @@ void register_cut(CLI::App& app) {
       "  isohex generate box -o cube.vtu -n 12 --size 2\n"
       "  isohex cut cube.vtu -o carved.vtu --surface \"sphere(1,1,1, 0.6)\" --keep outside\n"
       "  isohex cut cube.vtu -o two.vtu --surface \"plane(1,1,1, 1,0.3,0.2)\"   # two blocks, conforming\n"
-      "  isohex cut cube.vtu -o c.vtu --surface \"sphere(1,1,1,0.6)\" --surface \"sphere(0,0,1,0.5)\" --keep outside");
+      "  isohex cut cube.vtu -o c.vtu --surface \"sphere(1,1,1,0.6)\" --surface \"sphere(0,0,1,0.5)\" --keep outside\n"
+      "  isohex cut skin.vtu -o two.vtu --volume cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 "
+      "--iso 1150   # the bone a block of its own");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp .msh .exo)")->required();
   cmd->add_option("-o,--output", a->output, "The cut mesh")->required();
   cmd->add_option("--surface", a->surfaces,
                   "A cut surface as a shape expression (see 'isohex volume shape --help'); its inside is the shape's. "
-                  "Repeat for successive cuts")
-      ->required();
+                  "Repeat for successive cuts");
+  cmd->add_option("--volume", a->volume,
+                  "Cut along isosurfaces of this volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with "
+                  "--dims --type), after the --surface cuts; it should cover the mesh");
+  cmd->add_option("--iso", a->isos, "With --volume: an isovalue to cut along; repeat for successive cuts");
+  cmd->add_option("--inside", a->inside, "With --volume: which side of the isovalue is the inside (default above)")
+      ->check(CLI::IsMember({"above", "below"}));
+  a->read.add_to(cmd);
   cmd->add_option("--keep", a->keep,
                   "both (default: the inside becomes a new block, the cut a conforming interface), inside or outside")
       ->check(CLI::IsMember({"both", "inside", "outside"}));

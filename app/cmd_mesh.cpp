@@ -6,6 +6,7 @@
 #include "mesh_stages.hpp"
 
 #include "isohex/contour/dual_contour.hpp"
+#include "isohex/contour/iso_field.hpp"
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
@@ -48,11 +49,7 @@ struct Args {
   double cell_size = 0;
   Index resolution = 0, min_component = 8;
   double thin_features = 0.1;
-  // Raw layout (as in `isohex volume info`).
-  std::vector<Index> dims;
-  std::string type, endian = "little";
-  std::vector<double> spacing, origin;
-  std::size_t header_bytes = 0;
+  VolumeReadArgs read;  // the raw layout and memory limit, as in `isohex volume info`
   bool no_surface_smoothing = false, no_pillow = false, no_smooth = false;
   /// --boundary: slide (boundary vertices slide on their surfaces in the optimisation) or fixed;
   /// unset: slide unless --no-smooth.
@@ -65,27 +62,13 @@ struct Args {
   double surface_band = 0.3;  ///< --surface-band, in cell sizes
   std::string features = "round";  ///< --features
   std::vector<std::string> cuts;  ///< --cut EXPR...
+  std::vector<double> cut_isos;   ///< --cut-iso V...
   std::string keep = "both";      ///< --keep
   int* threads = nullptr;
 };
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-VolumeReadOptions read_options(const Args& a) {
-  VolumeReadOptions opt;
-  if (a.dims.empty() && a.type.empty() && a.spacing.empty() && a.origin.empty() && a.header_bytes == 0) return opt;
-  if (a.dims.empty() || a.type.empty()) throw Error("raw layout options need at least --dims NX NY NZ and --type");
-  RawLayout raw;
-  raw.dims = {a.dims[0], a.dims[1], a.dims[2]};
-  raw.type = *scalar_type_from_name(a.type);
-  raw.big_endian = a.endian == "big";
-  if (!a.spacing.empty()) raw.spacing = Vec3(a.spacing[0], a.spacing[1], a.spacing[2]);
-  if (!a.origin.empty()) raw.origin = Vec3(a.origin[0], a.origin[1], a.origin[2]);
-  raw.header_bytes = a.header_bytes;
-  opt.raw = raw;
-  return opt;
-}
 
 // The shape's signed distance sampled at half the mesh cell size, so that the trilinear
 // interpolant follows the shape closely within each mesh cell.
@@ -147,10 +130,11 @@ void run(const Args& a) {
     throw Error(fmt::format("{}: unknown mesh format (use {})", a.output, io::kMeshExtensions));
   const bool terminal = ::isatty(::fileno(stdout)) != 0;
   const auto start = Clock::now();
-  if (a.cuts.empty() && a.keep != "both") throw Error("--keep is only used with --cut");
+  const bool cutting_asked = !a.cuts.empty() || !a.cut_isos.empty();
+  if (!cutting_asked && a.keep != "both") throw Error("--keep is only used with --cut or --cut-iso");
   if (a.features == "sheets") {
     if (a.shape.empty()) throw Error("--features sheets meshes a --shape expression (a CSG solid), not a volume");
-    if (!a.cuts.empty()) throw Error("--features sheets already cuts along the shape's surfaces; add them to --shape");
+    if (cutting_asked) throw Error("--features sheets already cuts along the shape's surfaces; add them to --shape");
     std::vector<StageRow> rows;
     std::size_t inverted_left = 0;
     nlohmann::json j = mesh_shape_by_cuts(a.shape, a.cell_size, static_cast<int>(a.resolution), a.output,
@@ -187,8 +171,14 @@ void run(const Args& a) {
     spec.isovalue = a.iso.value_or(0);
   } else {
     if (!a.iso) throw Error("--iso V is required with a volume file");
-    volume = read_volume(a.volume, read_options(a));
+    volume = read_volume(a.volume, a.read.options());
     spec.isovalue = *a.iso;
+  }
+  std::vector<contour::LevelSet> cut_isos;  // the fields refer to `volume`, which outlives them
+  for (const double iso : a.cut_isos) {
+    if (iso == spec.isovalue || (a.iso2 && iso == *a.iso2))
+      throw Error(fmt::format("--cut-iso {}: that is the region's own isosurface, not a surface inside it", iso));
+    cut_isos.emplace_back(std::make_shared<const IsoField>(volume, iso, spec.inside, spec.interpolation));
   }
   const double read_time = seconds_since(start);
   if (spec.kind == contour::RegionKind::between) {
@@ -267,9 +257,10 @@ void run(const Args& a) {
   }
   nlohmann::json cutting;
   CutStage cut;
-  if (!cut_shapes.empty()) {
+  if (cutting_asked) {
     t = Clock::now();
-    cutting = cut_stage(out.mesh, out.vertex_place, region, cut_shapes, *cut_keep_from_name(a.keep), terminal, cut);
+    cutting = cut_stage(out.mesh, out.vertex_place, region, cut_shapes, cut_isos, *cut_keep_from_name(a.keep), terminal,
+                        cut);
     rows.push_back(stage_row("cut", out.mesh, seconds_since(t), keep_values));
   }
   release_free_memory();
@@ -280,7 +271,7 @@ void run(const Args& a) {
     SlideSpec slide;
     if (slides)
       slide = {&region, &out.vertex_place, feature_angle, a.surface_band * r.grid.h};
-    if (!cut_shapes.empty()) slide.cut = &cut, slide.domain = &region.domain;
+    if (cutting_asked) slide.cut = &cut, slide.domain = &region.domain;
     optimisation = optimise_stage(out.mesh, terminal, inverted_left, slide, &released);
     rows.push_back(stage_row("optimisation", out.mesh, seconds_since(t), keep_values));
     rows.back().extra = {{"untangle", optimisation["untangle"]["iterations"]},
@@ -288,7 +279,7 @@ void run(const Args& a) {
                          {"worst moves", optimisation["worst"]["moves"]}};
   }
 
-  if (!cut_shapes.empty()) report_cut_distances(cut, out.mesh, cutting);
+  if (cutting_asked) report_cut_distances(cut, out.mesh, cutting);
   release_free_memory();
   t = Clock::now();
   const ValidationReport check = validate(out.mesh);
@@ -472,6 +463,8 @@ void register_mesh(CLI::App& app) {
       "  isohex mesh --shape \"torus(0,0,0, 1,0.4)\" --resolution 40 -o torus.vtu\n"
       "  isohex mesh cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 --cell-size 4 "
       "--cut \"plane(0,110,0, 0,1,0)\" -o head.vtu   # the face cut off: two blocks\n"
+      "  isohex mesh cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 --cell-size 4 "
+      "--cut-iso 1150 -o head.vtu   # skin and bone: two blocks\n"
       "  isohex mesh --shape \"difference(box(0,0,0, 2,2,1), cylinder(1,1,-1, 1,1,2, 0.5))\" --features sheets "
       "--cell-size 0.1 -o plate.vtu");
   cmd->add_option("volume", a->volume, "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)");
@@ -545,20 +538,18 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--cut", a->cuts,
                   "After pillowing, cut the mesh along this shape expression's surface by sheet insertion (see 'isohex "
                   "cut'): a string of edges on the crease where it meets the isosurface; repeat for successive cuts");
-  cmd->add_option("--keep", a->keep, "With --cut: both (default: the inside a new block), inside or outside")
+  cmd->add_option("--cut-iso", a->cut_isos,
+                  "After pillowing (and the --cut shapes), cut the mesh along this isosurface of the same volume, its "
+                  "inside on the --inside side (e.g. the bone inside a skin mesh: two conforming blocks); repeat for "
+                  "successive cuts");
+  cmd->add_option("--keep", a->keep, "With --cut / --cut-iso: both (default: the inside a new block), inside or outside")
       ->check(CLI::IsMember({"both", "inside", "outside"}));
   cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
   cmd->add_option("--report", a->report,
                   "Write a report folder: report.json, quality histograms per stage (SVG, PNG), report.html with a 3D "
                   "cut-away view coloured by scaled Jacobian");
-  cmd->add_option("--dims", a->dims, "Raw files: grid points along x, y, z")->expected(3);
-  cmd->add_option("--type", a->type, "Raw files: the stored value type")
-      ->check(CLI::IsMember({"u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"}));
-  cmd->add_option("--endian", a->endian, "Raw files: byte order (default little)")->check(CLI::IsMember({"little", "big"}));
-  cmd->add_option("--spacing", a->spacing, "Raw files: distance between grid points (default 1 1 1)")->expected(3);
-  cmd->add_option("--origin", a->origin, "Raw files: position of the first grid point (default 0 0 0)")->expected(3);
-  cmd->add_option("--header-bytes", a->header_bytes, "Raw files: bytes to skip before the data");
+  a->read.add_to(cmd);
   a->threads = add_threads_option(cmd);
   cmd->callback([a] { run(*a); });
 }

@@ -18,49 +18,6 @@ namespace isohex::cli {
 
 namespace {
 
-/// Options shared by info and convert: the layout of headerless raw files and the memory
-/// limit.
-struct ReadArgs {
-  std::vector<Index> dims;
-  std::string type, endian = "little";
-  std::vector<double> spacing, origin;
-  std::size_t header_bytes = 0;
-  std::size_t max_memory = VolumeReadOptions{}.max_bytes;
-
-  void add_to(CLI::App* cmd) {
-    cmd->add_option("--dims", dims, "Raw files: grid points along x, y, z")->expected(3);
-    cmd->add_option("--type", type, "Raw files: the stored value type")
-        ->check(CLI::IsMember({"u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"}));
-    cmd->add_option("--endian", endian, "Raw files: byte order (default little)")
-        ->check(CLI::IsMember({"little", "big"}));
-    cmd->add_option("--spacing", spacing, "Raw files: distance between grid points along x, y, z (default 1 1 1)")
-        ->expected(3);
-    cmd->add_option("--origin", origin, "Raw files: position of the first grid point (default 0 0 0)")->expected(3);
-    cmd->add_option("--header-bytes", header_bytes, "Raw files: bytes to skip before the data (default 0)");
-    cmd->add_option("--max-memory", max_memory,
-                    "Refuse volumes whose float values need more than this many bytes (default 8GiB; "
-                    "suffixes KiB, MiB, GiB, ...)")
-        ->transform(CLI::AsSizeValue(false));
-  }
-
-  [[nodiscard]] VolumeReadOptions options() const {
-    VolumeReadOptions opt;
-    opt.max_bytes = max_memory;
-    const bool any_raw = !dims.empty() || !type.empty() || !spacing.empty() || !origin.empty() || header_bytes != 0;
-    if (!any_raw) return opt;
-    if (dims.empty() || type.empty()) throw Error("raw layout options need at least --dims NX NY NZ and --type");
-    RawLayout raw;
-    raw.dims = {dims[0], dims[1], dims[2]};
-    raw.type = *scalar_type_from_name(type);
-    raw.big_endian = endian == "big";
-    if (!spacing.empty()) raw.spacing = Vec3(spacing[0], spacing[1], spacing[2]);
-    if (!origin.empty()) raw.origin = Vec3(origin[0], origin[1], origin[2]);
-    raw.header_bytes = header_bytes;
-    opt.raw = raw;
-    return opt;
-  }
-};
-
 nlohmann::json vec_json(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 std::string vec_text(const Vec3& v) { return fmt::format("{:.6g} {:.6g} {:.6g}", v.x(), v.y(), v.z()); }
@@ -68,7 +25,7 @@ std::string vec_text(const Vec3& v) { return fmt::format("{:.6g} {:.6g} {:.6g}",
 struct InfoArgs {
   std::string file, json;
   std::size_t bins = 16;
-  ReadArgs read;
+  VolumeReadArgs read;
 };
 
 void run_info(const InfoArgs& a) {
@@ -122,7 +79,7 @@ void run_info(const InfoArgs& a) {
 struct ConvertArgs {
   std::string in, out;
   bool as_float = false;
-  ReadArgs read;
+  VolumeReadArgs read;
 };
 
 void run_convert(const ConvertArgs& a) {

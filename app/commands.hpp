@@ -23,14 +23,31 @@ int& exit_code();
 
 }  // namespace isohex::cli
 
+#include "isohex/volume/volume_io.hpp"
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/quality/summary.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <vector>
 
 namespace isohex::cli {
+
+/// How to read a volume (`isohex volume info|convert`, `isohex cut --volume`): the layout of
+/// headerless raw files and the memory limit.
+struct VolumeReadArgs {
+  std::vector<Index> dims;
+  std::string type, endian = "little";
+  std::vector<double> spacing, origin;
+  std::size_t header_bytes = 0;
+  std::size_t max_memory = VolumeReadOptions{}.max_bytes;
+
+  /// Adds --dims --type --endian --spacing --origin --header-bytes --max-memory.
+  void add_to(CLI::App* cmd);
+  /// The reader's options; throws isohex::Error for a partial raw layout.
+  [[nodiscard]] VolumeReadOptions options() const;
+};
 
 /// Reads a mesh for a command; prints how many non-hex cells were dropped, if any.
 HexMesh load_mesh(const std::string& file, bool skip_non_hex);

@@ -63,7 +63,8 @@ nlohmann::json cut_step_json(const CutStep& s, double max_distance) {
 }
 
 nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const contour::Region& region,
-                         const std::vector<Shape>& shapes, CutKeep keep, bool terminal, CutStage& stage) {
+                         const std::vector<Shape>& shapes, const std::vector<contour::LevelSet>& isosurfaces, CutKeep keep,
+                         bool terminal, CutStage& stage) {
   if (terminal) fmt::print("  cutting...\n"), std::fflush(stdout);
   CutOptions co;
   co.keep = keep;
@@ -71,7 +72,10 @@ nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, 
   for (const contour::LevelSet& f : contour::box_faces(region.domain)) co.boundary.push_back(f);
   stage.first_cut = static_cast<int>(co.boundary.size());
   co.feature_degrees = 180;  // a scan's boundary has no features: its vertices are on level sets
-  CutResult r = cut(mesh, shapes, co);
+  std::vector<contour::LevelSet> surfaces;
+  for (const Shape& s : shapes) surfaces.emplace_back(std::make_shared<const Shape>(s), cut_scale(mesh, co));
+  surfaces.insert(surfaces.end(), isosurfaces.begin(), isosurfaces.end());
+  CutResult r = cut(mesh, surfaces, co);
   nlohmann::json steps = nlohmann::json::array();
   for (std::size_t i = 0; i < r.steps.size(); ++i) {
     const CutStep& c = r.steps[i];
@@ -114,8 +118,8 @@ void report_cut_distances(const CutStage& stage, const HexMesh& mesh, nlohmann::
         far = std::max(far, std::abs(s.level(mesh.points[v])) / s.scale());
         ++n;
       }
-    fmt::print("cut {}: {} vertices on it after the optimisation, within {:.3g} of it (relative to the mesh's size)\n",
-               j + 1, n, far);
+    fmt::print("cut {}: {} vertices on it after the optimisation, within {:.3g} of it (relative to {})\n", j + 1, n,
+               far, s.field() ? "the volume's value range" : "the mesh's diagonal");
     cutting["cuts"][j]["final_max_relative_distance"] = far;
   }
 }
@@ -480,6 +484,7 @@ nlohmann::json optimise_stage(HexMesh& mesh, bool terminal, std::size_t& inverte
         if (c.first != BoundarySurface::kNone && c.first < slide.cut->first_cut && c.second < slide.cut->first_cut)
           c.pinned = true;
     surface = std::make_unique<BoundarySurface>(mesh, slide.cut->before, slide.cut->surfaces, cons);
+    surface->set_exact_from(slide.cut->first_cut);  // a cut along an isosurface is as exact as a shape
     if (slide.domain) surface->set_domain(*slide.domain);
     fmt::print("boundary: {} vertices slide (on the region's surfaces, the box and the cuts, and their curves); {} pinned\n",
                surface->num_sliding(), surface->num_pinned());

@@ -79,11 +79,13 @@ struct CutStage {
 /// `max_distance`: CutResult::max_distance of its surface.
 nlohmann::json cut_step_json(const CutStep& step, double max_distance);
 
-/// Cuts `mesh` (after pillowing) by `shapes` (CutOptions: `keep`, the boundary on the region's
+/// Cuts `mesh` (after pillowing) by `shapes`, then by `isosurfaces` (level sets of the volume's
+/// other isovalues) (CutOptions: `keep`, the boundary on the region's
 /// surfaces and the domain box's faces); `vertex_place` is rebuilt for the cut mesh (a boundary
 /// vertex on a region surface or the box keeps that place; a vertex on a cut is interior to it).
 nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const contour::Region& region,
-                         const std::vector<Shape>& shapes, CutKeep keep, bool terminal, CutStage& stage);
+                         const std::vector<Shape>& shapes, const std::vector<contour::LevelSet>& isosurfaces, CutKeep keep,
+                         bool terminal, CutStage& stage);
 
 /// Where the optimisation left each cut's vertices: the largest |L| / scale, printed and put in
 /// `cutting["cuts"][j]["final_max_relative_distance"]`.

@@ -1,5 +1,6 @@
 // Cutting by sheet insertion: geometry against the analytic surfaces, conformity, quality,
 // creases, errors, determinism.
+#include "isohex/contour/iso_field.hpp"
 #include "isohex/contour/region.hpp"
 #include "isohex/error.hpp"
 #include "isohex/mesh/generate.hpp"
@@ -273,6 +274,52 @@ TEST(Cut, ShapeLevelSet) {
   EXPECT_NE(s.describe().find("sphere(1, 2, 3, 0.5)"), std::string::npos);
   const Vec3 r = s.root(Vec3(1, 2, 3), Vec3(2, 2, 3));  // from inside to outside
   EXPECT_NEAR(r.x(), 1.5, 1e-9);
+}
+
+// A cut along a volume's isosurface: a torus's distance sampled every 0.04 (trilinear), its
+// isovalue 0 cutting the 12^3 cube into two conforming blocks. The cut vertices are on the
+// sampled field's isosurface (to 1e-7 of its range) and so within the interpolation error of the
+// exact torus.
+TEST(Cut, AlongAVolumesIsosurface) {
+  const Vec3 c(1, 1, 1);
+  const double major = 0.55, minor = 0.25;
+  const Volume vol = sample(Shape::torus(c, Vec3(0, 0, 1), major, minor),
+                            grid_from_cell_size({Vec3::Constant(-0.2), Vec3::Constant(2.2)}, 0.04));
+  const auto field = std::make_shared<const IsoField>(vol, 0.0, Inside::below);
+  const CutResult r = cut(box_mesh(12, 12, 12, Vec3::Zero(), Vec3(2, 2, 2)), {contour::LevelSet(field)});
+  const HexMesh& m = r.mesh;
+  EXPECT_TRUE(validate(m).valid());
+  EXPECT_EQ(below(m, 0.2), 0u);
+  EXPECT_GE(min_sj(m), 0.3);
+  EXPECT_EQ(not_certified(m), 0u);
+  ASSERT_EQ(r.surface_quads.size(), 1u);
+  EXPECT_GT(r.surface_quads[0].size(), 150u);
+  EXPECT_LE(r.max_distance[0], 1e-7);
+  // Exact distance to the torus (the oracle), and the two blocks share exactly the cut's quads.
+  const auto torus_distance = [&](const Vec3& p) {
+    const Vec3 d = p - c;
+    return std::abs(std::hypot(std::hypot(d.x(), d.y()) - major, d.z()) - minor);
+  };
+  double far = 0;
+  for (const Quad& q : r.surface_quads[0])
+    for (Index v : q) far = std::max(far, torus_distance(m.points[v]));
+  EXPECT_LE(far, 2e-3);  // trilinear interpolation of the distance at spacing 0.04
+  std::set<std::array<Index, 4>> faces[2];
+  for (Index h = 0; h < m.num_hexes(); ++h)
+    for (int f = 0; f < 6; ++f) {
+      const Quad q = face_vertices(m.hexes[h], f);
+      if (std::all_of(q.begin(), q.end(), [&](Index v) { return torus_distance(m.points[v]) <= 2e-3; })) {
+        std::array<Index, 4> k = q;
+        std::sort(k.begin(), k.end());
+        faces[m.blocks[h] == 0 ? 0 : 1].insert(k);
+      }
+    }
+  EXPECT_EQ(faces[0], faces[1]);
+  EXPECT_EQ(faces[0].size(), r.surface_quads[0].size());
+  // The face sets name both sides of the interface.
+  ASSERT_EQ(m.face_sets.size(), 2u);
+  EXPECT_EQ(m.face_sets[0].name, "cut1_inside");
+  EXPECT_EQ(m.face_sets[1].name, "cut1_outside");
 }
 
 TEST(Cut, CommandLine) {

@@ -14,18 +14,24 @@
   crease; those on the box's faces aside) on the isosurface to 1e-6 of the value range (trilinear interpolation of the raw volume here,
   by numpy). At y = 70 (through the nasal cavities' knife edges) none below 0.2 either: the
   crease vertices there are released into the band about the skin as a last resort, and stay
-  on the plane.
+  on the plane. At hexes of 3 (y = 110) none below 0.2.
+- The plane's cut written as Gmsh 4.1: gmsh -check passes, and its MSH 2.2 re-save has the
+  physical surfaces cut1_inside / cut1_outside (or cut1) holding exactly the quads on the plane.
+- Cuts along isosurfaces (hydrogen.vti): `isohex mesh --cut-iso` twice gives three nested blocks,
+  their shared points on the isosurfaces to 1e-6 of the range (numpy's trilinear interpolation);
+  `isohex cut --volume` of a box mesh.
 Exits non-zero on any failure.
 """
 import json
 import os
+import shutil
 import subprocess
 import sys
 
 import numpy as np
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
-from oracle_support import check, finish, oracle_args
+from oracle_support import check, finish, oracle_args, parse_msh22
 from vtk_support import hex_quality, read_vtu
 
 SPHERES = [((2, 2, 2), 1.2), ((2, 0.8, 1.0), 0.75), ((1.0, 2, 1.5), 0.7)]
@@ -137,6 +143,46 @@ def test_plane(cli, tmp):
         t.Update()
         ok, edges = closed_manifold(surface(t.GetOutput()))
         check(ok, f"plane: block {b}'s surface is a closed manifold ({edges} edges)")
+    plane_msh(cli, tmp, cube, n, f0, pts)
+
+
+def plane_msh(cli, tmp, cube, n, plane_quads, pts):
+    """The plane's cut written as Gmsh 4.1: gmsh checks it, and in its own MSH 2.2 re-save the
+    physical surfaces cut1_inside and cut1_outside (both sides kept) or cut1 (one side) hold
+    exactly the quads on the plane (by coordinates); "boundary" every boundary quad."""
+    gmsh = shutil.which("gmsh")
+    if gmsh is None:
+        print("SKIP (Gmsh face sets): the gmsh command is not installed (scripts/install-deps.sh installs it)")
+        return
+    def key(points):  # a quad by its corners, to 1e-9 (Gmsh's re-save rounds the coordinates)
+        return tuple(sorted(tuple(np.round(np.asarray(p) * 1e9).astype(np.int64).tolist()) for p in points))
+    on_plane = {key(pts[list(q)]) for q in plane_quads}
+    for keep, names in (("both", ["cut1_inside", "cut1_outside"]), ("inside", ["cut1"])):
+        msh, re22 = os.path.join(tmp, f"halves_{keep}.msh"), os.path.join(tmp, f"halves_{keep}.22.msh")
+        rc, log = run([cli, "cut", cube, "-o", msh, "--keep", keep, "--surface", "plane(1,1,1, 1,0.3,0.2)"])
+        if not check(rc == 0, f"isohex cut to .msh ({keep}) exit {rc}: {log[-400:]}"):
+            continue
+        rc, out = run([gmsh, msh, "-check"])
+        check(rc == 0 and "Error" not in out and "Warning" not in out, f"gmsh -check cut .msh ({keep}): {out[-600:]}")
+        rc, out = run([gmsh, msh, "-save", "-format", "msh22", "-o", re22])
+        if not check(rc == 0 and os.path.exists(re22), f"gmsh re-saves the cut .msh ({keep}): {out[-400:]}"):
+            continue
+        phys, nodes, elems = parse_msh22(re22)
+        surfaces = sorted(name for (d, _), name in phys.items() if d == 2)
+        check(surfaces == sorted(["boundary"] + names), f"cut .msh ({keep}): Gmsh's physical surfaces {surfaces}")
+        tag_of = {name: t for (d, t), name in phys.items() if d == 2}
+        for name in names:
+            corners = [np.array([nodes[v] for v in ns]) for (ty, p, ns) in elems if ty == 3 and p == tag_of[name]]
+            quads = {key(q) for q in corners}
+            far = max(np.abs((q - 1) @ n).max() for q in corners) if corners else float("inf")
+            check(len(quads) > 100 and (keep == "inside" or quads == on_plane) and far <= 1e-9,
+                  f"cut .msh ({keep}): {name} has {len(quads)} quads, {len(quads ^ on_plane)} differ from the plane's "
+                  f"{len(on_plane)}, farthest {far:.3g} from it")
+        bnd = [ns for (ty, p, ns) in elems if ty == 3 and p == tag_of["boundary"]]
+        out_vtu = os.path.join(tmp, f"halves_{keep}.vtu")
+        rc, _ = run([cli, "convert", msh, out_vtu])
+        want = surface(read_vtu(out_vtu)).GetNumberOfCells() if rc == 0 else -1
+        check(len(bnd) == want, f"cut .msh ({keep}): 'boundary' has {len(bnd)} quads, VTK's surface of the mesh {want}")
 
 
 def trilinear(vol, spacing, p):
@@ -153,14 +199,19 @@ def trilinear(vol, spacing, p):
     return out
 
 
+def cthead_mesh(cli, raw):
+    """`isohex mesh` of cthead's skin (iso 600)."""
+    return [cli, "mesh", raw, "--dims", "256", "256", "113", "--type", "i16", "--endian", "big", "--spacing", "1", "1", "2",
+            "--iso", "600"]
+
+
 def test_cthead(cli, data, tmp):
     raw = os.path.join(data, "volumes", "cthead_256x256x113_int16be.raw")
     if not os.path.exists(raw):
         print("SKIP (cthead): no shared data")
         return
     out = os.path.join(tmp, "head_cut.vtu")
-    rc, log = run([cli, "mesh", raw, "--dims", "256", "256", "113", "--type", "i16", "--endian", "big", "--spacing", "1",
-                   "1", "2", "--iso", "600", "--cell-size", "4", "--cut", "plane(0,110,0, 0,1,0)", "-o", out])
+    rc, log = run(cthead_mesh(cli, raw) + ["--cell-size", "4", "--cut", "plane(0,110,0, 0,1,0)", "-o", out])
     if not check(rc == 0, f"isohex mesh --cut (cthead) exit {rc}: {log[-800:]}"):
         return
     grid = read_vtu(out)
@@ -189,8 +240,7 @@ def test_cthead(cli, data, tmp):
     # y = 70 runs through the nasal cavities' knife edges: the rounds' last resort releases crease
     # vertices about the skin (within the band of 0.3 cells), still exactly on the plane.
     out70, js70 = os.path.join(tmp, "head_cut70.vtu"), os.path.join(tmp, "head_cut70.json")
-    rc, log = run([cli, "mesh", raw, "--dims", "256", "256", "113", "--type", "i16", "--endian", "big", "--spacing", "1",
-                   "1", "2", "--iso", "600", "--cell-size", "4", "--cut", "plane(0,70,0, 0,1,0)", "-o", out70, "--json", js70])
+    rc, log = run(cthead_mesh(cli, raw) + ["--cell-size", "4", "--cut", "plane(0,70,0, 0,1,0)", "-o", out70, "--json", js70])
     if not check(rc == 0, f"isohex mesh --cut y = 70 (cthead) exit {rc}: {log[-800:]}"):
         return
     sj = hex_quality(read_vtu(out70))
@@ -199,6 +249,75 @@ def test_cthead(cli, data, tmp):
     check(j["cutting"]["cuts"][0]["final_max_relative_distance"] <= 1e-9,
           f"cthead cut at y = 70: cut vertices within {j['cutting']['cuts'][0]['final_max_relative_distance']:.3g} of the plane")
     check(j["released_max_distance"] <= 0.3 * 4 * (1 + 1e-3), f"cthead cut at y = 70: released within {j['released_max_distance']:.3g}")
+    # Hexes of 3: where the plane crosses the skin's rim on the volume's top face, two neighbouring
+    # rim vertices must not both be on the cut (they would meet at the one point of the three).
+    out3 = os.path.join(tmp, "head_cut_h3.vtu")
+    rc, log = run(cthead_mesh(cli, raw) + ["--cell-size", "3", "--cut", "plane(0,110,0, 0,1,0)", "-o", out3])
+    if check(rc == 0, f"isohex mesh --cut at h 3 (cthead) exit {rc}: {log[-800:]}"):
+        sj = hex_quality(read_vtu(out3))
+        check(int((sj < 0.2).sum()) == 0, f"cthead cut at h 3: {(sj < 0.2).sum()} hexes below 0.2 by VTK (min {sj.min():.4f})")
+
+
+def read_vti(path):
+    """Values (z, y, x), spacing and origin of a .vti, by VTK's reader."""
+    r = vtk.vtkXMLImageDataReader()
+    r.SetFileName(path)
+    r.Update()
+    img = r.GetOutput()
+    nx, ny, nz = img.GetDimensions()
+    vals = vtk_to_numpy(img.GetPointData().GetScalars()).astype(np.float64).reshape(nz, ny, nx)
+    return vals, np.array(img.GetSpacing()), np.array(img.GetOrigin())
+
+
+def test_isosurface_cuts(cli, data, tmp):
+    """Cuts along a volume's isosurfaces: the hydrogen orbital's density meshed at 0.05 and cut at
+    0.2 and 0.5 (`isohex mesh --cut-iso`): three blocks (nested shells), none below 0.2 by VTK,
+    every point two blocks share on one of the two isosurfaces to 1e-6 of the value range (numpy's
+    trilinear interpolation of the file read by VTK). And `isohex cut --volume` of a box mesh."""
+    vti = os.path.join(data, "volumes", "hydrogen.vti")
+    if not os.path.exists(vti):
+        print("SKIP (isosurface cuts): no shared data")
+        return
+    vals, spacing, origin = read_vti(vti)
+    value_range = vals.max() - vals.min()
+    out = os.path.join(tmp, "hydrogen_cut.vtu")
+    rc, log = run([cli, "mesh", vti, "--iso", "0.05", "--cell-size", "2", "--cut-iso", "0.2", "--cut-iso", "0.5", "-o", out])
+    if not check(rc == 0, f"isohex mesh --cut-iso (hydrogen) exit {rc}: {log[-800:]}"):
+        return
+    grid = read_vtu(out)
+    sj = hex_quality(grid)
+    print(f"hydrogen cut at 0.2 and 0.5: {grid.GetNumberOfCells()} hexes, VTK scaled Jacobian min {sj.min():.4f}")
+    check(int((sj < 0.2).sum()) == 0, f"hydrogen cuts: {(sj < 0.2).sum()} hexes below 0.2 by VTK (min {sj.min():.4f})")
+    blocks = vtk_to_numpy(grid.GetCellData().GetArray("block"))
+    check(len(set(blocks.tolist())) == 3, f"hydrogen cuts: blocks {sorted(set(blocks.tolist()))}")
+    hexes = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
+    pts = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
+    ids = sorted(set(blocks.tolist()))
+    for a in range(3):
+        for b in range(a + 1, 3):
+            shared = np.intersect1d(np.unique(hexes[blocks == ids[a]]), np.unique(hexes[blocks == ids[b]]))
+            if len(shared) == 0:
+                continue
+            f = trilinear(vals, spacing, pts[shared] - origin)
+            off = np.min(np.abs(f[:, None] - np.array([0.2, 0.5])[None, :]), axis=1) / value_range
+            check(len(shared) > 50 and off.max() <= 1e-6,
+                  f"hydrogen cuts: blocks {ids[a]}/{ids[b]} share {len(shared)} points, farthest |f - iso| / range {off.max():.3g}")
+    # isohex cut --volume: a box mesh over the density cut at 0.1, the inside kept.
+    box, carved = os.path.join(tmp, "hbox.vtu"), os.path.join(tmp, "hbox_cut.vtu")
+    rc, log = run([cli, "generate", "box", "-n", "16", "--size", "40", "-o", box])
+    check(rc == 0, f"generate: {log}")
+    # The box spans [0, 40]^3, the density's lobes about (31.5, 31.5, 31.5) cross its faces.
+    rc, log = run([cli, "cut", box, "-o", carved, "--volume", vti, "--iso", "0.1", "--keep", "inside"])
+    if check(rc in (0, 1), f"isohex cut --volume exit {rc}: {log[-800:]}"):
+        g = read_vtu(carved)
+        sj = hex_quality(g)
+        bpts = vtk_to_numpy(surface(g).GetPoints().GetData()).astype(np.float64)
+        f = trilinear(vals, spacing, bpts - origin)
+        on_box = np.min(np.minimum(np.abs(bpts), np.abs(bpts - 40)), axis=1) <= 1e-9 * 40
+        off = np.abs(f[~on_box] - 0.1) / value_range
+        print(f"box cut at 0.1: {g.GetNumberOfCells()} hexes, VTK min SJ {sj.min():.4f}, {len(off)} points on the isosurface")
+        check(rc == 0 and int((sj < 0.2).sum()) == 0, f"box cut at 0.1: exit {rc}, {(sj < 0.2).sum()} below 0.2 (min {sj.min():.4f})")
+        check(len(off) > 100 and off.max() <= 1e-6, f"box cut at 0.1: boundary points off the box within {off.max():.3g} of the isosurface")
 
 
 def main():
@@ -206,6 +325,7 @@ def main():
     test_spheres(args.cli, args.tmp)
     test_plane(args.cli, args.tmp)
     test_cthead(args.cli, args.data, args.tmp)
+    test_isosurface_cuts(args.cli, args.data, args.tmp)
     return finish()
 
 

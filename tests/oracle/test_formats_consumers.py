@@ -34,7 +34,7 @@ import vtk
 from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from vtk_support import read_vtu
 
-from oracle_support import check, finish, oracle_args
+from oracle_support import check, finish, oracle_args, parse_msh22
 
 
 def run(cmd):
@@ -227,30 +227,6 @@ def check_exodus(path, ref):
 
 
 # ---- Gmsh through the gmsh command-line tool ---------------------------------------------
-
-def parse_msh22(path):
-    """Physical names, nodes by tag and elements (type, physical, nodes) of an ASCII MSH 2.2 file."""
-    lines = open(path).read().split("\n")
-    names, nodes, elems = {}, {}, []
-    i = 0
-    while i < len(lines):
-        s = lines[i].strip()
-        if s == "$PhysicalNames":
-            for k in range(int(lines[i + 1])):
-                d, t, n = lines[i + 2 + k].split(maxsplit=2)
-                names[(int(d), int(t))] = n.strip('"')
-        elif s == "$Nodes":
-            for k in range(int(lines[i + 1])):
-                f = lines[i + 2 + k].split()
-                nodes[int(f[0])] = [float(x) for x in f[1:4]]
-        elif s == "$Elements":
-            for k in range(int(lines[i + 1])):
-                f = [int(x) for x in lines[i + 2 + k].split()]
-                ntags = f[2]
-                elems.append((f[1], f[3], f[3 + ntags:]))
-        i += 1
-    return names, nodes, elems
-
 
 def match_points(pts, ref_points):
     """For each row of `pts`, the index of the equal (to 1e-15 relative) row of `ref_points`;

@@ -3,7 +3,11 @@
 // Layout: one volume entity per block (tag = position in the block table + 1) in a
 // physical volume whose tag is the block's file id and whose name is block_name(value);
 // one surface entity per block that owns boundary quads, holding those quads, all in the
-// physical surface 1 "boundary" and each listed as a bounding surface of its volume.
+// physical surface 1 "boundary" and each listed as a bounding surface of its volume; each
+// non-empty named face set (HexMesh::face_sets, e.g. a cut's faces) is its own physical surface
+// (tag 2, 3, ... in the sets' order, named as the set) over one more surface entity with its
+// quads, oriented outward from their hexes; sets of the same quads (the two sides of an
+// interface) share one entity, as Gmsh wants each element once.
 // Gmsh's 8-node hexahedron numbers its corners as VTK does (0-1-2-3 one face, i+4 above i),
 // so hexes are written as they are; quads are the outward boundary quads.
 //
@@ -21,6 +25,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -91,9 +96,62 @@ void write_box(MshOut& out, const Box& b) {
   for (int d = 0; d < 3; ++d) out.real(b.hi[d]);
 }
 
+std::array<Index, 4> sorted_quad(const HexMesh& mesh, Index h, int f) {
+  std::array<Index, 4> q{};
+  for (std::size_t i = 0; i < 4; ++i)
+    q[i] = mesh.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(kHexFaces[static_cast<std::size_t>(f)][i])];
+  std::sort(q.begin(), q.end());
+  return q;
+}
+
+// The named face sets as surface entities (see the file comment).
+struct SetEntities {
+  std::vector<const FaceSet*> named;   // the non-empty sets: physical tags 2, 3, ...
+  std::vector<const FaceSet*> sets;    // the set of each entity ...
+  std::vector<std::vector<int>> tags;  // ... and its physical tags: 1 too when its quads are all boundary quads
+  std::size_t faces = 0;               // quads in all entities
+  std::vector<std::uint8_t> taken;     // per boundary face: in such an entity, not in its block's surface
+};
+
+SetEntities face_set_entities(const HexMesh& mesh, const std::vector<BoundaryFace>& boundary) {
+  SetEntities e;
+  e.taken.assign(boundary.size(), 0);
+  std::vector<std::pair<std::array<Index, 4>, std::size_t>> on_boundary;
+  for (std::size_t i = 0; i < boundary.size(); ++i) on_boundary.emplace_back(sorted_quad(mesh, boundary[i].hex, boundary[i].face), i);
+  std::sort(on_boundary.begin(), on_boundary.end());
+  std::vector<std::vector<std::array<Index, 4>>> keys_of;
+  for (const FaceSet& fs : mesh.face_sets) {
+    if (fs.faces.empty()) continue;
+    e.named.push_back(&fs);
+    const int tag = static_cast<int>(e.named.size()) + 1;
+    std::vector<std::array<Index, 4>> keys;
+    for (const auto& [h, f] : fs.faces) keys.push_back(sorted_quad(mesh, h, f));
+    std::sort(keys.begin(), keys.end());
+    if (const auto same = std::find(keys_of.begin(), keys_of.end(), keys); same != keys_of.end()) {
+      e.tags[static_cast<std::size_t>(same - keys_of.begin())].push_back(tag);
+      continue;
+    }
+    std::vector<std::size_t> found;
+    for (const auto& k : keys) {
+      const auto it = std::lower_bound(on_boundary.begin(), on_boundary.end(), std::make_pair(k, std::size_t{0}));
+      if (it == on_boundary.end() || it->first != k) break;
+      found.push_back(it->second);
+    }
+    const bool boundary_set = found.size() == keys.size();
+    if (boundary_set)
+      for (const std::size_t i : found) e.taken[i] = 1;
+    e.sets.push_back(&fs);
+    e.tags.push_back(boundary_set ? std::vector<int>{1, tag} : std::vector<int>{tag});
+    keys_of.push_back(std::move(keys));
+    e.faces += fs.faces.size();
+  }
+  return e;
+}
+
 void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
   const BlockTable blocks = block_table(mesh);
   const std::vector<BoundaryFace> faces = boundary_faces(mesh);
+  const SetEntities named = face_set_entities(mesh, faces);
   // A mesh without hexes still needs one volume to hold its nodes.
   const std::size_t num_volumes = std::max<std::size_t>(blocks.values.size(), mesh.points.empty() ? 0 : 1);
   auto block_of_hex = [&](Index h) { return static_cast<std::size_t>(blocks.of_hex[static_cast<std::size_t>(h)]); };
@@ -105,7 +163,7 @@ void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
   std::vector<std::vector<std::size_t>> surface_faces(num_volumes);
   for (std::size_t f = 0; f < faces.size(); ++f) {
     const std::size_t b = block_of_hex(faces[f].hex);
-    surface_faces[b].push_back(f);
+    if (!named.taken[f]) surface_faces[b].push_back(f);
     for (const int k : kHexFaces[static_cast<std::size_t>(faces[f].face)]) {
       const Index v = mesh.hexes[static_cast<std::size_t>(faces[f].hex)][static_cast<std::size_t>(k)];
       surface_box[b].add(mesh.points[static_cast<std::size_t>(v)]);
@@ -132,6 +190,13 @@ void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
     if (!(b.lo.array() <= b.hi.array()).all()) b.lo = b.hi = Vec3::Zero();
   std::size_t num_surfaces = 0;
   for (const auto& s : surface_faces) num_surfaces += s.empty() ? 0 : 1;
+  const auto face_box = [&](const FaceSet& fs) {
+    Box box;
+    for (const auto& [h, f] : fs.faces)
+      for (const int k : kHexFaces[static_cast<std::size_t>(f)])
+        box.add(mesh.points[static_cast<std::size_t>(mesh.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(k)])]);
+    return box;
+  };
 
   MshOut out(stream, binary);
   out.begin("MeshFormat");
@@ -144,14 +209,15 @@ void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
 
   // Physical names are text in both encodings.
   out.begin("PhysicalNames");
-  out.text(fmt::format("{}\n", blocks.values.size() + (faces.empty() ? 0 : 1)));
+  out.text(fmt::format("{}\n", blocks.values.size() + (faces.empty() ? 0 : 1) + named.named.size()));
   if (!faces.empty()) out.text("2 1 \"boundary\"\n");
+  for (std::size_t j = 0; j < named.named.size(); ++j) out.text(fmt::format("2 {} \"{}\"\n", j + 2, named.named[j]->name));
   for (std::size_t b = 0; b < blocks.values.size(); ++b)
     out.text(fmt::format("3 {} \"{}\"\n", blocks.file_ids[b], block_name(blocks.values[b])));
   out.text("$EndPhysicalNames\n");
 
   out.begin("Entities");
-  for (const std::uint64_t n : {std::uint64_t{0}, std::uint64_t{0}, std::uint64_t{num_surfaces}, std::uint64_t{num_volumes}})
+  for (const std::uint64_t n : {std::uint64_t{0}, std::uint64_t{0}, std::uint64_t{num_surfaces + named.sets.size()}, std::uint64_t{num_volumes}})
     out.size(n);
   out.eol();
   for (std::size_t b = 0; b < num_volumes; ++b) {
@@ -161,6 +227,14 @@ void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
     out.size(1);
     out.tag(1);  // physical surface "boundary"
     out.size(0);  // no bounding curves: the mesh has no curve entities
+    out.eol();
+  }
+  for (std::size_t j = 0; j < named.sets.size(); ++j) {
+    out.tag(static_cast<int>(num_volumes + j) + 1);
+    write_box(out, face_box(*named.sets[j]));
+    out.size(named.tags[j].size());
+    for (const int tag : named.tags[j]) out.tag(tag);
+    out.size(0);
     out.eol();
   }
   for (std::size_t b = 0; b < num_volumes; ++b) {
@@ -212,8 +286,8 @@ void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
   // Elements: hexes per volume (hex order), then quads per surface.
   std::vector<std::vector<Index>> hexes_of(num_volumes);
   for (std::size_t h = 0; h < mesh.hexes.size(); ++h) hexes_of[block_of_hex(static_cast<Index>(h))].push_back(static_cast<Index>(h));
-  const std::size_t num_elements = mesh.hexes.size() + faces.size();
-  std::size_t element_blocks = num_surfaces;
+  const std::size_t num_elements = mesh.hexes.size() + faces.size() - static_cast<std::size_t>(std::count(named.taken.begin(), named.taken.end(), 1)) + named.faces;
+  std::size_t element_blocks = num_surfaces + named.sets.size();
   for (const auto& h : hexes_of) element_blocks += h.empty() ? 0 : 1;
   out.begin("Elements");
   out.size(element_blocks);
@@ -235,21 +309,32 @@ void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
     }
   }
   std::uint64_t quad_tag = mesh.hexes.size();
-  for (std::size_t b = 0; b < num_volumes; ++b) {
-    if (surface_faces[b].empty()) continue;
+  // One block of quads in surface entity `entity`: face(i) is the (hex, local face) of quad i.
+  const auto write_quads = [&](std::size_t entity, std::size_t count, const auto& face) {
     out.tag(2);
-    out.tag(static_cast<int>(b) + 1);
+    out.tag(static_cast<int>(entity) + 1);
     out.tag(kGmshQuad4);
-    out.size(surface_faces[b].size());
+    out.size(count);
     out.eol();
-    for (const std::size_t f : surface_faces[b]) {
+    for (std::size_t i = 0; i < count; ++i) {
+      const auto [hex, local] = face(i);
       out.size(++quad_tag);
-      const Hex& h = mesh.hexes[static_cast<std::size_t>(faces[f].hex)];
-      for (const int k : kHexFaces[static_cast<std::size_t>(faces[f].face)])
+      const Hex& h = mesh.hexes[static_cast<std::size_t>(hex)];
+      for (const int k : kHexFaces[static_cast<std::size_t>(local)])
         out.size(static_cast<std::uint64_t>(h[static_cast<std::size_t>(k)]) + 1);
       out.eol();
     }
-  }
+  };
+  for (std::size_t b = 0; b < num_volumes; ++b)
+    if (!surface_faces[b].empty())
+      write_quads(b, surface_faces[b].size(), [&](std::size_t i) {
+        const BoundaryFace& f = faces[surface_faces[b][i]];
+        return std::pair<Index, int>(f.hex, f.face);
+      });
+  for (std::size_t j = 0; j < named.sets.size(); ++j)
+    write_quads(num_volumes + j, named.sets[j]->faces.size(), [&](std::size_t i) {
+      return std::pair<Index, int>(named.sets[j]->faces[i].first, named.sets[j]->faces[i].second);
+    });
   out.end("Elements");
   out.flush();
 }

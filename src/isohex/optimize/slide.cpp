@@ -230,7 +230,7 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
   // Exact surfaces stay exact: a vertex on a shape (a cut surface) is not released, nor a corner
   // where constraints pinned it; one on a cut's crease with an isosurface only after
   // set_release_creases(), about the isosurface while it stays on the cut (band_clamp()).
-  const auto on_shape = [&](int k) { return k >= 0 && surfaces_[static_cast<std::size_t>(k)].shape() != nullptr; };
+  const auto on_shape = [&](int k) { return exact(k); };
   for (Index v : vertices) {
     if (v < 0 || static_cast<std::size_t>(v) >= role_.size()) continue;
     if (on_shape(target(v))) continue;
@@ -309,11 +309,9 @@ bool BoundarySurface::band_clamp(Index v, Vec3& x, double /*len*/) const {
   // The projection follows the gradient, not the straight line to the nearest point, so the
   // foot seen from the clamped point can differ a little: a few rounds settle it, and a step
   // whose foot does not settle is refused.
-  // A crease vertex released about its isosurface keeps to its cut (a shape): onto it first,
+  // A crease vertex released about its isosurface keeps to its cut (exact): onto it first,
   // and again after each step to the band's edge, until both hold.
-  const contour::LevelSet* cut =
-      second(v) >= 0 && surfaces_[static_cast<std::size_t>(second(v))].shape() ? &surfaces_[static_cast<std::size_t>(second(v))]
-                                                                               : nullptr;
+  const contour::LevelSet* cut = exact(second(v)) ? &surfaces_[static_cast<std::size_t>(second(v))] : nullptr;
   if (cut && !cut->project(x, kFootReach * band_)) return false;
   Vec3 foot;
   for (int round = 0; round < (cut ? 20 : 5); ++round) {

@@ -29,6 +29,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace isohex {
@@ -108,6 +109,13 @@ class BoundarySurface {
   /// Lets loosen() release the vertices where a cut meets an isosurface (the last resort of
   /// `isohex mesh --cut`: their hexes stayed below 0.2 with the crease on the isosurface).
   void set_release_creases(bool on) { release_creases_ = on; }
+  /// Makes surfaces()[k] for k >= `first` exact like a shape (loosen() never releases a vertex
+  /// on one): the cuts along a volume's isosurfaces of `isohex mesh --cut-iso`.
+  void set_exact_from(int first) { exact_from_ = first; }
+  /// True for surfaces()[k] that loosen() keeps exact: a shape's, or from set_exact_from() on.
+  [[nodiscard]] bool exact(int k) const {
+    return k >= 0 && (k >= exact_from_ || surfaces_[static_cast<std::size_t>(k)].shape() != nullptr);
+  }
   /// Where loose vertex v at x would sit on its target (`len`: the local edge length): the
   /// nearest triangle point, a rim vertex's point on its curve, else its foot point on its
   /// level set. False where there is none.
@@ -198,6 +206,7 @@ class BoundarySurface {
   std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
   double band_ = 0;
   bool release_creases_ = false;
+  int exact_from_ = std::numeric_limits<int>::max();
   Aabb domain_{Vec3::Zero(), Vec3::Zero()};
   bool has_domain_ = false;
   std::vector<std::array<Vec3, 3>> tris_;

@@ -107,8 +107,18 @@ struct CutResult {
   std::vector<BoundarySurface::Constraint> constraints;
 };
 
+/// The unit of a cut's relative distances: CutOptions::scale, or the diagonal of `mesh`'s
+/// bounding box (the scale cut() gives the LevelSets of shapes). Throws for an empty mesh.
+double cut_scale(const HexMesh& mesh, const CutOptions& options);
+
 /// Cuts `mesh` (a valid hex mesh) by each surface in turn. Throws isohex::Error for an invalid
 /// mesh, a surface that misses it (every hex on one side) or a kept side that would be empty.
 CutResult cut(const HexMesh& mesh, const std::vector<Shape>& surfaces, const CutOptions& options = {});
+
+/// The same for surfaces given as level sets, positive inside (contour::LevelSet: a shape's, or
+/// an isosurface of a volume, e.g. the bone inside a skin mesh: the cut makes the two materials
+/// conforming blocks). The cut vertices go onto |L| <= the level set's tolerance (1e-7 of an
+/// isosurface's value range); CutResult::max_distance is |L| / its scale().
+CutResult cut(const HexMesh& mesh, const std::vector<contour::LevelSet>& surfaces, const CutOptions& options = {});
 
 }  // namespace isohex

@@ -1,0 +1,139 @@
+// The two sides of a cut: classification and its cleaning (see internal/cut_steps.hpp).
+#include "isohex/sheets/internal/cut_steps.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace isohex::internal {
+
+std::vector<std::uint8_t> first_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb,
+                                      const contour::LevelSet& surface) {
+  std::vector<std::uint8_t> side(m.hexes.size());
+  for (Index h = 0; h < m.num_hexes(); ++h) {
+    Vec3 at = Vec3::Zero();
+    int faces = 0;
+    for (int f = 0; f < 6; ++f)
+      if (nb[h][f] < 0) {
+        for (Index v : face_vertices(m.hexes[h], f)) at += m.points[v];
+        ++faces;
+      }
+    side[h] = surface.level(faces ? Vec3(at / (4.0 * faces)) : m.centroid(h)) > 0;
+  }
+  return side;
+}
+
+std::vector<EarlierFace> faces_on_earlier_cuts(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb,
+                                               const std::vector<Keeps>& keeps, int first_cut,
+                                               const contour::LevelSet& surface) {
+  std::vector<EarlierFace> out;
+  for (Index h = 0; h < m.num_hexes(); ++h)
+    for (int f = 0; f < 6; ++f) {
+      const Index g = nb[h][f];
+      if (g < h) continue;
+      const Quad q = face_vertices(m.hexes[h], f);
+      const bool on = std::any_of(keeps[q[0]].begin(), keeps[q[0]].end(), [&](const Keep& k) {
+        return k.surface >= first_cut &&
+               std::all_of(q.begin() + 1, q.end(), [&](Index v) { return on_surface(keeps[v], k.surface); });
+      });
+      if (!on) continue;
+      Vec3 c = Vec3::Zero();
+      for (Index v : q) c += m.points[v];
+      out.push_back({h, g, static_cast<std::uint8_t>(surface.level(c / 4.0) > 0)});
+    }
+  return out;
+}
+
+void settle_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb, const std::vector<EarlierFace>& earlier,
+                  const std::vector<std::uint8_t>& locked, std::vector<std::uint8_t>& side, std::size_t& moved) {
+  for (int round = 0; round < 100; ++round) {
+    bool changed = false;
+    for (const EarlierFace& e : earlier)
+      for (Index h : {e.h, e.g})
+        if (side[h] != e.side && !locked[h]) side[h] = e.side, changed = true;
+    std::vector<Index> flip;
+    for (Index h = 0; h < m.num_hexes(); ++h) {
+      if (locked[h]) continue;
+      int across = 0;
+      for (Index g : nb[h]) across += g >= 0 && side[g] != side[h];
+      if (across >= 4) flip.push_back(h);
+    }
+    for (Index h : flip) side[h] = !side[h];
+    moved += flip.size();
+    if (!changed && flip.empty()) break;
+  }
+}
+
+std::size_t unreachable_to_one_side(const HexMesh& m, const Incidence& inc, const std::vector<std::uint8_t>& side,
+                                    const std::vector<Keeps>& keeps, int cut_id, const Placer& placer,
+                                    std::vector<std::uint8_t>& next, std::vector<std::uint8_t>& locked) {
+  const std::vector<contour::LevelSet>& levels = placer.levels;
+  next = side;
+  std::size_t bad = 0;
+  for (Index v = 0; v < m.num_vertices(); ++v) {
+    bool in = false, out = false;
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) (side[inc.ids[k]] ? in : out) = true;
+    if (!(in && out)) continue;
+    Keeps trial = keeps[v];
+    trial.push_back({cut_id, Vec3::Zero()});
+    Vec3 x = m.points[v];
+    if (placer.place(x, trial)) continue;
+    ++bad;
+    // The side of its hexes locked before (a neighbour's), else of its own sign: the spot where
+    // the cut only grazes the surface goes to one side as a whole.
+    std::uint8_t to = levels[static_cast<std::size_t>(cut_id)].level(m.points[v]) > 0;
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+      if (locked[inc.ids[k]]) {
+        to = next[inc.ids[k]];
+        break;
+      }
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k)
+      if (!locked[inc.ids[k]]) next[inc.ids[k]] = to, locked[inc.ids[k]] = 1;
+  }
+  return bad;
+}
+
+namespace {
+
+// How many keeps two vertices share (a level set, or a face of the input's triangles facing alike).
+int shared_keeps(const Keeps& a, const Keeps& b, double cos_limit) {
+  int n = 0;
+  for (const Keep& x : a)
+    n += std::any_of(b.begin(), b.end(), [&](const Keep& y) {
+      return x.surface == y.surface && (x.surface >= 0 || x.facing.dot(y.facing) >= cos_limit);
+    });
+  return n;
+}
+
+}  // namespace
+
+std::size_t doubled_curve_ends(const Incidence& inc, const std::vector<std::array<Index, 2>>& edges,
+                               const std::vector<Keeps>& keeps, double cos_limit, std::vector<std::uint8_t>& side,
+                               std::vector<std::uint8_t>& locked) {
+  // For vertex v: the side its hexes would join and how many change; -1 if locked both ways
+  // or already on one side.
+  const auto plan = [&](Index v, std::uint8_t& to) {
+    int count[2] = {0, 0}, held[2] = {0, 0};
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) {
+      const Index h = inc.ids[k];
+      ++count[side[h]];
+      held[side[h]] += locked[h];
+    }
+    if (count[0] == 0 || count[1] == 0 || (held[0] && held[1])) return -1;
+    to = held[1] ? 1 : held[0] ? 0 : count[1] > count[0];
+    return count[!to];
+  };
+  std::size_t moved = 0;
+  for (const auto& [a, b] : edges) {
+    if (keeps[a].size() < 2 || keeps[b].size() < 2 || shared_keeps(keeps[a], keeps[b], cos_limit) < 2) continue;
+    std::uint8_t to_a = 0, to_b = 0;
+    const int na = plan(a, to_a), nb = plan(b, to_b);
+    if (na < 0 || nb < 0) continue;
+    const Index v = na <= nb ? a : b;
+    const std::uint8_t to = na <= nb ? to_a : to_b;
+    for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) side[inc.ids[k]] = to, locked[inc.ids[k]] = 1;
+    ++moved;
+  }
+  return moved;
+}
+
+}  // namespace isohex::internal
