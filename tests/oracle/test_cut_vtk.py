@@ -185,6 +185,22 @@ def plane_msh(cli, tmp, cube, n, plane_quads, pts):
         check(len(bnd) == want, f"cut .msh ({keep}): 'boundary' has {len(bnd)} quads, VTK's surface of the mesh {want}")
 
 
+def meshed(cmd, what):
+    """Runs `cmd`; the mesh it wrote (its -o) checked by VTK to have no hex below 0.2: (grid,
+    block per hex, hexes, points), or None when it failed."""
+    rc, log = run(cmd)
+    if not check(rc == 0, f"{what}: exit {rc}: {log[-800:]}"):
+        return None
+    grid = read_vtu(cmd[cmd.index("-o") + 1])
+    sj = hex_quality(grid)
+    print(f"{what}: {grid.GetNumberOfCells()} hexes, VTK scaled Jacobian min {sj.min():.4f}")
+    check(int((sj < 0.2).sum()) == 0, f"{what}: {(sj < 0.2).sum()} hexes below 0.2 by VTK (min {sj.min():.4f})")
+    blocks = vtk_to_numpy(grid.GetCellData().GetArray("block"))
+    hexes = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
+    pts = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
+    return grid, blocks, hexes, pts
+
+
 def trilinear(vol, spacing, p):
     """The trilinear interpolant of vol[z, y, x] at world points p (N x 3), origin 0."""
     g = p / spacing
@@ -211,17 +227,12 @@ def test_cthead(cli, data, tmp):
         print("SKIP (cthead): no shared data")
         return
     out = os.path.join(tmp, "head_cut.vtu")
-    rc, log = run(cthead_mesh(cli, raw) + ["--cell-size", "4", "--cut", "plane(0,110,0, 0,1,0)", "-o", out])
-    if not check(rc == 0, f"isohex mesh --cut (cthead) exit {rc}: {log[-800:]}"):
+    got = meshed(cthead_mesh(cli, raw) + ["--cell-size", "4", "--cut", "plane(0,110,0, 0,1,0)", "-o", out],
+                 "cthead cut at y = 110")
+    if got is None:
         return
-    grid = read_vtu(out)
-    sj = hex_quality(grid)
-    print(f"cthead cut at y = 110: {grid.GetNumberOfCells()} hexes, VTK scaled Jacobian min {sj.min():.4f}")
-    check(int((sj < 0.2).sum()) == 0, f"cthead cut: {(sj < 0.2).sum()} hexes below 0.2 by VTK")
-    blocks = vtk_to_numpy(grid.GetCellData().GetArray("block"))
+    grid, blocks, hexes, pts = got
     check(sorted(set(blocks.tolist())) == [0, 1], f"cthead cut: blocks {sorted(set(blocks.tolist()))}")
-    hexes = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
-    pts = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
     shared = np.intersect1d(np.unique(hexes[blocks == 0]), np.unique(hexes[blocks == 1]))
     check(len(shared) > 500 and np.abs(pts[shared, 1] - 110).max() <= 1e-9,
           f"cthead cut: {len(shared)} shared points, farthest {np.abs(pts[shared, 1] - 110).max():.3g} from the plane")
@@ -251,11 +262,9 @@ def test_cthead(cli, data, tmp):
     check(j["released_max_distance"] <= 0.3 * 4 * (1 + 1e-3), f"cthead cut at y = 70: released within {j['released_max_distance']:.3g}")
     # Hexes of 3: where the plane crosses the skin's rim on the volume's top face, two neighbouring
     # rim vertices must not both be on the cut (they would meet at the one point of the three).
-    out3 = os.path.join(tmp, "head_cut_h3.vtu")
-    rc, log = run(cthead_mesh(cli, raw) + ["--cell-size", "3", "--cut", "plane(0,110,0, 0,1,0)", "-o", out3])
-    if check(rc == 0, f"isohex mesh --cut at h 3 (cthead) exit {rc}: {log[-800:]}"):
-        sj = hex_quality(read_vtu(out3))
-        check(int((sj < 0.2).sum()) == 0, f"cthead cut at h 3: {(sj < 0.2).sum()} hexes below 0.2 by VTK (min {sj.min():.4f})")
+    for h in ("3",):
+        meshed(cthead_mesh(cli, raw) + ["--cell-size", h, "--cut", "plane(0,110,0, 0,1,0)", "-o",
+                                        os.path.join(tmp, f"head_cut_h{h}.vtu")], f"cthead cut at y = 110, h {h}")
 
 
 def read_vti(path):
@@ -281,17 +290,12 @@ def test_isosurface_cuts(cli, data, tmp):
     vals, spacing, origin = read_vti(vti)
     value_range = vals.max() - vals.min()
     out = os.path.join(tmp, "hydrogen_cut.vtu")
-    rc, log = run([cli, "mesh", vti, "--iso", "0.05", "--cell-size", "2", "--cut-iso", "0.2", "--cut-iso", "0.5", "-o", out])
-    if not check(rc == 0, f"isohex mesh --cut-iso (hydrogen) exit {rc}: {log[-800:]}"):
+    got = meshed([cli, "mesh", vti, "--iso", "0.05", "--cell-size", "2", "--cut-iso", "0.2", "--cut-iso", "0.5", "-o", out],
+                 "hydrogen cut at 0.2 and 0.5")
+    if got is None:
         return
-    grid = read_vtu(out)
-    sj = hex_quality(grid)
-    print(f"hydrogen cut at 0.2 and 0.5: {grid.GetNumberOfCells()} hexes, VTK scaled Jacobian min {sj.min():.4f}")
-    check(int((sj < 0.2).sum()) == 0, f"hydrogen cuts: {(sj < 0.2).sum()} hexes below 0.2 by VTK (min {sj.min():.4f})")
-    blocks = vtk_to_numpy(grid.GetCellData().GetArray("block"))
+    grid, blocks, hexes, pts = got
     check(len(set(blocks.tolist())) == 3, f"hydrogen cuts: blocks {sorted(set(blocks.tolist()))}")
-    hexes = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
-    pts = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
     ids = sorted(set(blocks.tolist()))
     for a in range(3):
         for b in range(a + 1, 3):

@@ -50,16 +50,18 @@ void settle_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb,
     for (const EarlierFace& e : earlier)
       for (Index h : {e.h, e.g})
         if (side[h] != e.side && !locked[h]) side[h] = e.side, changed = true;
-    std::vector<Index> flip;
+    // One hex at a time, in order: each flip takes at least two faces off the interface, so
+    // this ends; flipping all at once would swap a checkerboard back and forth (a plane through
+    // the middle of a layer of hexes, their centroids' signs mixed).
+    std::size_t flips = 0;
     for (Index h = 0; h < m.num_hexes(); ++h) {
       if (locked[h]) continue;
       int across = 0;
       for (Index g : nb[h]) across += g >= 0 && side[g] != side[h];
-      if (across >= 4) flip.push_back(h);
+      if (across >= 4) side[h] = !side[h], ++flips;
     }
-    for (Index h : flip) side[h] = !side[h];
-    moved += flip.size();
-    if (!changed && flip.empty()) break;
+    moved += flips;
+    if (!changed && flips == 0) break;
   }
 }
 

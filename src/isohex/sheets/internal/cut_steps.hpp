@@ -79,8 +79,8 @@ std::vector<EarlierFace> faces_on_earlier_cuts(const HexMesh& m, const std::vect
                                                const contour::LevelSet& surface);
 
 // Round after round until nothing changes: the hexes on faces of earlier cuts take those faces'
-// sides, and a hex with four or more faces towards the other side moves across (`moved` counts
-// those); hexes flagged in `locked` stay.
+// sides, and a hex with four or more faces towards the other side moves across, one at a time
+// (`moved` counts those); hexes flagged in `locked` stay.
 void settle_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb, const std::vector<EarlierFace>& earlier,
                   const std::vector<std::uint8_t>& locked, std::vector<std::uint8_t>& side, std::size_t& moved);
 
