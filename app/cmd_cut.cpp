@@ -121,8 +121,8 @@ void register_cut(CLI::App& app) {
       "  isohex cut cube.vtu -o carved.vtu --surface \"sphere(1,1,1, 0.6)\" --keep outside\n"
       "  isohex cut cube.vtu -o two.vtu --surface \"plane(1,1,1, 1,0.3,0.2)\"   # two blocks, conforming\n"
       "  isohex cut cube.vtu -o c.vtu --surface \"sphere(1,1,1,0.6)\" --surface \"sphere(0,0,1,0.5)\" --keep outside\n"
-      "  isohex cut skin.vtu -o two.vtu --volume cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 "
-      "--iso 1150   # the bone a block of its own");
+      "  isohex generate box -o box.vtu -n 16 --size 40\n"
+      "  isohex cut box.vtu -o lobes.vtu --volume hydrogen.vti --iso 0.1 --keep inside   # along an isosurface");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp .msh .exo)")->required();
   cmd->add_option("-o,--output", a->output, "The cut mesh")->required();
   cmd->add_option("--surface", a->surfaces,

@@ -463,8 +463,8 @@ void register_mesh(CLI::App& app) {
       "  isohex mesh --shape \"torus(0,0,0, 1,0.4)\" --resolution 40 -o torus.vtu\n"
       "  isohex mesh cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 --cell-size 4 "
       "--cut \"plane(0,110,0, 0,1,0)\" -o head.vtu   # the face cut off: two blocks\n"
-      "  isohex mesh cthead.raw --dims 256 256 113 --type i16 --endian big --spacing 1 1 2 --iso 600 --cell-size 4 "
-      "--cut-iso 1150 -o head.vtu   # skin and bone: two blocks\n"
+      "  isohex mesh hydrogen.vti --iso 0.05 --cell-size 2 --cut-iso 0.2 --cut-iso 0.5 -o shells.vtu   # three "
+      "nested blocks\n"
       "  isohex mesh --shape \"difference(box(0,0,0, 2,2,1), cylinder(1,1,-1, 1,1,2, 0.5))\" --features sheets "
       "--cell-size 0.1 -o plate.vtu");
   cmd->add_option("volume", a->volume, "Volume (.nrrd .nhdr .mhd .mha .vtk .vti .nii .nii.gz, or .raw with --dims --type)");
@@ -540,7 +540,7 @@ void register_mesh(CLI::App& app) {
                   "cut'): a string of edges on the crease where it meets the isosurface; repeat for successive cuts");
   cmd->add_option("--cut-iso", a->cut_isos,
                   "After pillowing (and the --cut shapes), cut the mesh along this isosurface of the same volume, its "
-                  "inside on the --inside side (e.g. the bone inside a skin mesh: two conforming blocks); repeat for "
+                  "inside on the --inside side (a material interface: two conforming blocks; the material must be several cells thick); repeat for "
                   "successive cuts");
   cmd->add_option("--keep", a->keep, "With --cut / --cut-iso: both (default: the inside a new block), inside or outside")
       ->check(CLI::IsMember({"both", "inside", "outside"}));

@@ -116,9 +116,9 @@ double cut_scale(const HexMesh& mesh, const CutOptions& options);
 CutResult cut(const HexMesh& mesh, const std::vector<Shape>& surfaces, const CutOptions& options = {});
 
 /// The same for surfaces given as level sets, positive inside (contour::LevelSet: a shape's, or
-/// an isosurface of a volume, e.g. the bone inside a skin mesh: the cut makes the two materials
-/// conforming blocks). The cut vertices go onto |L| <= the level set's tolerance (1e-7 of an
-/// isosurface's value range); CutResult::max_distance is |L| / its scale().
+/// an isosurface of a volume: a material interface inside a mesh, the two materials conforming
+/// blocks where each is several cells thick). The cut vertices go onto |L| <= the level set's
+/// tolerance (1e-7 of an isosurface's value range); CutResult::max_distance is |L| / its scale().
 CutResult cut(const HexMesh& mesh, const std::vector<contour::LevelSet>& surfaces, const CutOptions& options = {});
 
 }  // namespace isohex
