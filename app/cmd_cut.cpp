@@ -55,7 +55,8 @@ void run(const Args& a) {
   Volume volume;
   if (!a.volume.empty()) volume = read_volume(a.volume, read);
   std::vector<contour::LevelSet> surfaces;
-  for (const Shape& s : shapes) surfaces.emplace_back(std::make_shared<const Shape>(s), cut_scale(mesh, CutOptions{}));
+  const double scale = cut_scale(mesh, CutOptions{});
+  for (const Shape& s : shapes) surfaces.emplace_back(std::make_shared<const Shape>(s), scale);
   for (const double iso : a.isos)
     surfaces.emplace_back(std::make_shared<const IsoField>(volume, iso, *inside_from_name(a.inside)));
   CutOptions opt;

@@ -73,7 +73,8 @@ nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, 
   stage.first_cut = static_cast<int>(co.boundary.size());
   co.feature_degrees = 180;  // a scan's boundary has no features: its vertices are on level sets
   std::vector<contour::LevelSet> surfaces;
-  for (const Shape& s : shapes) surfaces.emplace_back(std::make_shared<const Shape>(s), cut_scale(mesh, co));
+  const double scale = cut_scale(mesh, co);
+  for (const Shape& s : shapes) surfaces.emplace_back(std::make_shared<const Shape>(s), scale);
   surfaces.insert(surfaces.end(), isosurfaces.begin(), isosurfaces.end());
   CutResult r = cut(mesh, surfaces, co);
   nlohmann::json steps = nlohmann::json::array();

@@ -21,6 +21,7 @@
 #include "isohex/io/format_support.hpp"
 #include "isohex/io/mesh_io.hpp"
 #include "isohex/io/solver_sets.hpp"
+#include "isohex/mesh/topology.hpp"
 
 #include <fmt/format.h>
 
@@ -96,10 +97,8 @@ void write_box(MshOut& out, const Box& b) {
   for (int d = 0; d < 3; ++d) out.real(b.hi[d]);
 }
 
-std::array<Index, 4> sorted_quad(const HexMesh& mesh, Index h, int f) {
-  std::array<Index, 4> q{};
-  for (std::size_t i = 0; i < 4; ++i)
-    q[i] = mesh.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(kHexFaces[static_cast<std::size_t>(f)][i])];
+Quad sorted_quad(const HexMesh& mesh, Index h, int f) {
+  Quad q = face_vertices(mesh.hexes[static_cast<std::size_t>(h)], f);
   std::sort(q.begin(), q.end());
   return q;
 }
@@ -116,15 +115,15 @@ struct SetEntities {
 SetEntities face_set_entities(const HexMesh& mesh, const std::vector<BoundaryFace>& boundary) {
   SetEntities e;
   e.taken.assign(boundary.size(), 0);
-  std::vector<std::pair<std::array<Index, 4>, std::size_t>> on_boundary;
+  std::vector<std::pair<Quad, std::size_t>> on_boundary;
   for (std::size_t i = 0; i < boundary.size(); ++i) on_boundary.emplace_back(sorted_quad(mesh, boundary[i].hex, boundary[i].face), i);
   std::sort(on_boundary.begin(), on_boundary.end());
-  std::vector<std::vector<std::array<Index, 4>>> keys_of;
+  std::vector<std::vector<Quad>> keys_of;
   for (const FaceSet& fs : mesh.face_sets) {
     if (fs.faces.empty()) continue;
     e.named.push_back(&fs);
     const int tag = static_cast<int>(e.named.size()) + 1;
-    std::vector<std::array<Index, 4>> keys;
+    std::vector<Quad> keys;
     for (const auto& [h, f] : fs.faces) keys.push_back(sorted_quad(mesh, h, f));
     std::sort(keys.begin(), keys.end());
     if (const auto same = std::find(keys_of.begin(), keys_of.end(), keys); same != keys_of.end()) {
@@ -193,8 +192,7 @@ void write_msh(std::ostream& stream, const HexMesh& mesh, bool binary) {
   const auto face_box = [&](const FaceSet& fs) {
     Box box;
     for (const auto& [h, f] : fs.faces)
-      for (const int k : kHexFaces[static_cast<std::size_t>(f)])
-        box.add(mesh.points[static_cast<std::size_t>(mesh.hexes[static_cast<std::size_t>(h)][static_cast<std::size_t>(k)])]);
+      for (const Index v : face_vertices(mesh.hexes[static_cast<std::size_t>(h)], f)) box.add(mesh.points[static_cast<std::size_t>(v)]);
     return box;
   };
 
