@@ -26,7 +26,7 @@ struct Args {
   std::vector<std::string> surfaces;
   std::vector<double> isos;
   VolumeReadArgs read;
-  double offset = CutOptions{}.offset, feature_angle = CutOptions{}.feature_degrees;
+  double offset = CutOptions{}.offset, feature_angle = CutOptions{}.feature_degrees, tie_band = 0;
   int rings = CutOptions{}.rings;
   bool no_optimize = false, skip_non_hex = false;
   int* threads = nullptr;
@@ -64,6 +64,7 @@ void run(const Args& a) {
   opt.offset = a.offset;
   opt.feature_degrees = a.feature_angle;
   opt.rings = a.rings;
+  opt.tie_band = a.tie_band;
   opt.optimize = !a.no_optimize;
   fmt::print("{}: {} hexes, {} vertices; {} cut(s), keep {}\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
              surfaces.size(), a.keep);
@@ -73,6 +74,7 @@ void run(const Args& a) {
   report["input"] = a.input;
   report["output"] = a.output;
   report["keep"] = a.keep;
+  report["tie_band"] = a.tie_band;
   nlohmann::json steps = nlohmann::json::array();
   for (std::size_t i = 0; i < r.steps.size(); ++i) {
     const CutStep& s = r.steps[i];
@@ -145,6 +147,11 @@ void register_cut(CLI::App& app) {
       ->check(CLI::Range(0.0, 180.0));
   cmd->add_option("--rings", a->rings, "Optimise the vertices within this many hex rings of the new sheets (default 3)")
       ->check(CLI::Range(0, 1000));
+  cmd->add_option("--tie-band", a->tie_band,
+                  "Hexes whose centre is within this fraction of their size of a surface count as outside it "
+                  "(default 0: the sign alone; e.g. 0.05 where a surface runs through the middle of a layer of "
+                  "slightly moved hexes)")
+      ->check(CLI::Range(0.0, 0.5));
   cmd->add_flag("--no-optimize", a->no_optimize, "Place the new sheets on the surfaces but do not optimise");
   cmd->add_option("--json", a->json, "Write a JSON report");
   cmd->add_flag("--skip-non-hex", a->skip_non_hex, "Drop non-hexahedral cells instead of failing");

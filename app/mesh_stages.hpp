@@ -63,8 +63,10 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 /// invalid run once more from their start in a band 5/3 as wide, and the better run is kept
 /// (`band` then holds the wider band). `poor_left` (may be null): whether hexes are still below
 /// 0.2 or have a jacobian ratio below 0.1 after the rounds (or before them, where none ran).
+/// `widen_if_poor`: rounds that leave hexes below 0.2 (valid or not) run again wider too.
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& options,
-                              std::size_t* reattached = nullptr, bool* poor_left = nullptr);
+                              std::size_t* reattached = nullptr, bool* poor_left = nullptr,
+                              bool widen_if_poor = false);
 
 /// What `isohex mesh --cut` leaves for the optimisation: the mesh it cut (its boundary quads
 /// are the surface of vertices on no level set), the level sets (the region's surfaces, the
@@ -85,7 +87,26 @@ nlohmann::json cut_step_json(const CutStep& step, double max_distance);
 /// vertex on a region surface or the box keeps that place; a vertex on a cut is interior to it).
 nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, const contour::Region& region,
                          const std::vector<Shape>& shapes, const std::vector<contour::LevelSet>& isosurfaces, CutKeep keep,
-                         bool terminal, CutStage& stage);
+                         bool terminal, CutStage& stage, double tie_band = 0);
+
+/// How the cut and the optimisation after it ended, by the certified scaled Jacobian: hexes
+/// below 0.2 and the minimum (`isohex mesh --cut` tries a tie band when the first leaves some).
+struct CutAttemptScore {
+  std::size_t below = 0;
+  double min_sj = 2;
+};
+CutAttemptScore cut_attempt_score(const HexMesh& mesh);
+
+/// One attempt's results, kept aside while the next runs.
+struct CutAttempt {
+  HexMesh mesh;
+  std::vector<std::int8_t> place;
+  CutStage cut;
+  nlohmann::json cutting, optimisation;
+  std::size_t inverted_left = 0;
+  std::vector<std::uint8_t> released;
+  std::vector<StageRow> rows;
+};
 
 /// Where the optimisation left each cut's vertices: the largest |L| / scale, printed and put in
 /// `cutting["cuts"][j]["final_max_relative_distance"]`.

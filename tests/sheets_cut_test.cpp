@@ -191,6 +191,33 @@ TEST(Cut, PlaneKeepsBothSidesConforming) {
   EXPECT_GT(creases, 40u);
 }
 
+// A plane through the middle of a layer of hexes whose vertices are a little off the grid
+// (as smoothing leaves them): the layer's centroids lie within the noise of the plane, on
+// both sides of it. By their signs the interface zigzags between the layer's two faces; with
+// a tie band (CutOptions::tie_band) the cut takes one face of the layer (one quad per column)
+// and moves it onto the plane.
+TEST(Cut, PlaneThroughTheMiddleOfALayer) {
+  HexMesh box = box_mesh(8, 8, 8);
+  jitter(box, 0.02 / 8, 3);  // well below the hex's size, enough to mix the centroids' signs
+  const double y = 4.5 / 8;
+  std::size_t above = 0, below_plane = 0;
+  for (Index h = 0; h < box.num_hexes(); ++h) {
+    const double c = box.centroid(h).y();
+    if (std::abs(c - y) < 0.5 / 8) (c > y ? above : below_plane)++;
+  }
+  ASSERT_GT(above, 5u);  // the premise: the layer's signs are mixed
+  ASSERT_GT(below_plane, 5u);
+  const Shape plane = Shape::plane(Vec3(0, y, 0), Vec3(0, 1, 0));
+  EXPECT_GT(cut(box, {plane}).surface_quads[0].size(), 64u);
+  CutOptions o;
+  o.tie_band = 0.05;
+  const CutResult r = cut(box, {plane}, o);
+  EXPECT_EQ(r.surface_quads[0].size(), 64u);
+  EXPECT_EQ(below(r.mesh, 0.2), 0u);
+  EXPECT_EQ(not_certified(r.mesh), 0u);
+  EXPECT_GT(min_sj(r.mesh), 0.5);
+}
+
 // Other sizes and shapes, and a bumpy (jittered) cube, stay valid with nothing below 0.2.
 TEST(Cut, OtherCellSizesAndShapes) {
   struct Case {

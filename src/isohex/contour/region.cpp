@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace isohex::contour {
 
@@ -149,6 +151,30 @@ bool LevelSet::project(Vec3& p, double max_distance) const {
   if (n == 0 || std::abs(n - radius_) > max_distance) return false;
   p = center_ + d * (radius_ / n);
   return true;
+}
+
+bool LevelSet::bracket(Vec3& p, double max_distance) const {
+  Vec3 g;
+  const double l0 = level(p, g);
+  if (std::abs(l0) <= tolerance_) return true;
+  std::vector<Vec3> dirs = {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+  if (g.norm() > 0) dirs.insert(dirs.begin(), g.normalized());
+  for (double t = max_distance / 16; t <= max_distance * (1 + 1e-12); t *= 2) {
+    double best = std::numeric_limits<double>::infinity();
+    Vec3 found = p;
+    for (const Vec3& d : dirs)
+      for (const double sign : {1.0, -1.0}) {
+        const Vec3 y = p + sign * t * d;
+        if ((level(y) > 0) == (l0 > 0)) continue;
+        const Vec3 r = l0 > 0 ? root(p, y) : root(y, p);
+        if ((r - p).norm() < best) best = (r - p).norm(), found = r;
+      }
+    if (best < std::numeric_limits<double>::infinity()) {
+      p = found;
+      return true;
+    }
+  }
+  return false;
 }
 
 bool LevelSet::project_shape(Vec3& p, double max_distance) const {

@@ -50,6 +50,12 @@ class LevelSet {
   [[nodiscard]] Vec3 root(const Vec3& a, const Vec3& b) const;
   /// Moves `p` onto the surface, at most `max_distance` away; true on success (|L| ≤ tolerance).
   bool project(Vec3& p, double max_distance) const;
+  /// Moves `p` to the nearest sign change of L found along the gradient's direction and the
+  /// three axes, both ways, at distances doubling from max_distance / 16 to `max_distance`,
+  /// bisected onto the surface; true on success. Slower than project() but sure where it
+  /// finds a change: on a scan's isosurface a plateau of values just off the isovalue can
+  /// send Newton's steps far from a surface that lies close by.
+  bool bracket(Vec3& p, double max_distance) const;
   /// |L| below which a point counts as on the surface: 1e-7 of the volume's value range
   /// (so |f − iso| ≤ 1e-7 × range), or 1e-10 of a sphere's radius or a box's largest side.
   [[nodiscard]] double tolerance() const { return tolerance_; }

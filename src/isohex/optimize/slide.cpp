@@ -260,6 +260,7 @@ std::size_t BoundarySurface::loosen(const HexMesh& mesh, const std::vector<Index
   }
   loose_ += n;
   band_ = band;
+  if (reach_unit_ == 0) reach_unit_ = band;
   return n;
 }
 
@@ -290,11 +291,23 @@ bool BoundarySurface::foot_point(Index v, const Vec3& x, double max_reach, Vec3&
   }
   if (target(v) < 0) return false;
   // The shortest reach first: the Newton walk of a wider one can wander off to a farther part
-  // of a noisy isosurface. The same sequence from the same point gives the same foot, so
-  // band_clamp() and offset() agree.
-  for (double reach = band_ > 0 ? band_ : max_reach;; reach = std::min(2 * reach, max_reach)) {
+  // of a noisy isosurface. Then a sign change within it: on a scan's plateau Newton's steps
+  // can fail there and find a foot far away. The reaches start at the first band loosen() was
+  // given, whatever the band now: a vertex clamped in the first band then has the same foot in
+  // a wider one (with the reaches of each band, cthead h 5 plane y = 100 measured a vertex
+  // clamped in 1.5 mm at 6.3 mm in 2.5 and failed its band check; the skin was 2.5 away). So
+  // the last reach is the first doubling at or past max_reach, not max_reach itself (h 4 y =
+  // 60: a foot found at 16 in a band of 2 was 13 away at 19.2 in 3.33). The same sequence
+  // from the same point gives the same foot, so band_clamp() and offset() agree.
+  const contour::LevelSet& s = surfaces_[target(v)];
+  const double first = reach_unit_ > 0 ? std::min(reach_unit_, max_reach) : max_reach;
+  for (double reach = first;; reach *= 2) {
     foot = x;
-    if (surfaces_[target(v)].project(foot, reach)) return true;
+    if (s.project(foot, reach)) return true;
+    if (reach == first && s.field()) {
+      foot = x;
+      if (s.bracket(foot, first)) return true;
+    }
     if (reach >= max_reach) return false;
   }
 }

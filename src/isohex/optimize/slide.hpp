@@ -189,8 +189,9 @@ class BoundarySurface {
   /// x onto the curve of v's two constraints (Newton steps within `len`); false if it fails.
   bool project_on_curve(Index v, Vec3& x, double len) const;
   void classify(const HexMesh& mesh, double feature_degrees, bool keep_triangles);
-  /// v's foot point on its target from x: projections of growing reach (band_, doubled, up to
-  /// max_reach); false if none succeeds.
+  /// v's foot point on its target from x: projections of growing reach (the first band,
+  /// doubled until at or past max_reach; a bracketed sign change after the first); false if
+  /// none succeeds.
   bool foot_point(Index v, const Vec3& x, double max_reach, Vec3& foot) const;
   static constexpr double kFootReach = 8;  // × band: the reach from a point within the band
   void assign_targets(const HexMesh& mesh, const std::vector<std::int8_t>& place, const std::vector<std::uint8_t>* pin);
@@ -205,6 +206,7 @@ class BoundarySurface {
   std::vector<std::uint8_t> unpinned_;  // per vertex (or empty): loosen() released it from pinned
   std::size_t sliding_ = 0, pinned_ = 0, loose_ = 0;
   double band_ = 0;
+  double reach_unit_ = 0;  // the first band loosen() set: foot_point()'s first reach
   bool release_creases_ = false;
   int exact_from_ = std::numeric_limits<int>::max();
   Aabb domain_{Vec3::Zero(), Vec3::Zero()};

@@ -127,7 +127,9 @@ struct Cutting {
     m = in;
   }
 
-  [[nodiscard]] Placer placer() const { return {levels, tris, tri_tol, reach, edge}; }
+  [[nodiscard]] Placer placer() const {
+    return {levels, tris, tri_tol, reach, edge, options.domain ? &*options.domain : nullptr};
+  }
 
   // The sides of the cut (1 = inside), settled, the vertices the cut cannot reach sent to one side;
   // the hexes in `forced` take the given side and keep it.
@@ -136,7 +138,7 @@ struct Cutting {
     const std::vector<std::array<Index, 6>> nb = face_neighbours(m);
     const std::vector<EarlierFace> earlier = faces_on_earlier_cuts(m, nb, keeps, first_cut, surface);
     std::vector<std::uint8_t> locked(m.hexes.size(), 0);
-    std::vector<std::uint8_t> side = first_sides(m, nb, surface);
+    std::vector<std::uint8_t> side = first_sides(m, nb, surface, options.tie_band);
     for (const auto& [h, to] : forced) side[h] = to, locked[h] = 1;
     settle_sides(m, nb, earlier, locked, side, step.moved_across);
     const Incidence inc = vertex_hexes(m);

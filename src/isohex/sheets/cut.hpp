@@ -30,6 +30,7 @@
 #include "isohex/volume/implicit.hpp"
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,16 @@ struct CutOptions {
   /// A surface that misses the mesh (every hex on one side) is skipped (CutStep::missed)
   /// instead of an error.
   bool skip_missing = false;
+  /// No vertex is placed outside this box (`isohex mesh`: the volume's domain, past whose faces
+  /// an isosurface goes on): an interface vertex whose place would lie outside sends its hexes
+  /// to one side, as one that cannot be placed does.
+  std::optional<Aabb> domain;
+  /// A hex whose centre lies within `tie_band` × its mean edge length of a cut surface counts as
+  /// outside it, as one exactly on it does (0: the sign alone). Where the surface runs through
+  /// the middle of a layer of hexes that smoothing moved a little, the signs there are noise and
+  /// the interface zigzags between the layer's two faces; a tie band takes one face of it
+  /// (`isohex mesh --cut` cuts again with 0.05 when the first cut leaves hexes below 0.2).
+  double tie_band = 0;
   ProgressCallback progress;
 };
 

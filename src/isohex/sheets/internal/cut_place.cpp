@@ -67,38 +67,23 @@ bool Placer::by_turns(Vec3& x, const Keeps& keeps) const {
 }
 
 bool Placer::place(Vec3& x, const Keeps& keeps) const {
+  Vec3 y = x;
+  if (!place_anywhere(y, keeps) || (domain && !domain->contains(y, 1e-9 * (domain->hi - domain->lo).norm())))
+    return false;
+  x = y;
+  return true;
+}
+
+bool Placer::place_anywhere(Vec3& x, const Keeps& keeps) const {
   if (newton(x, keeps)) return true;
   if (keeps.size() <= 3 && by_turns(x, keeps)) return true;
   for (const Keep& k : keeps) {
     if (k.surface < 0 || !levels[static_cast<std::size_t>(k.surface)].field()) continue;
     Vec3 y = x;
-    if (bracket(y, levels[static_cast<std::size_t>(k.surface)]) && (newton(y, keeps) || (keeps.size() <= 3 && by_turns(y, keeps))) &&
+    const contour::LevelSet& s = levels[static_cast<std::size_t>(k.surface)];
+    if (s.bracket(y, 4 * step) && (newton(y, keeps) || (keeps.size() <= 3 && by_turns(y, keeps))) &&
         (y - x).norm() <= reach) {
       x = y;
-      return true;
-    }
-  }
-  return false;
-}
-
-bool Placer::bracket(Vec3& x, const contour::LevelSet& s) const {
-  Vec3 g;
-  const double l0 = s.level(x, g);
-  if (std::abs(l0) <= s.tolerance()) return true;
-  std::vector<Vec3> dirs = {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
-  if (g.norm() > 0) dirs.insert(dirs.begin(), g.normalized());
-  for (double t = step / 4; t <= 4 * step; t *= 2) {
-    double best = std::numeric_limits<double>::infinity();
-    Vec3 found = x;
-    for (const Vec3& d : dirs)
-      for (const double sign : {1.0, -1.0}) {
-        const Vec3 y = x + sign * t * d;
-        if ((s.level(y) > 0) == (l0 > 0)) continue;
-        const Vec3 r = l0 > 0 ? s.root(x, y) : s.root(y, x);
-        if ((r - x).norm() < best) best = (r - x).norm(), found = r;
-      }
-    if (best < std::numeric_limits<double>::infinity()) {
-      x = found;
       return true;
     }
   }

@@ -7,7 +7,7 @@
 namespace isohex::internal {
 
 std::vector<std::uint8_t> first_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb,
-                                      const contour::LevelSet& surface) {
+                                      const contour::LevelSet& surface, double tie_band) {
   std::vector<std::uint8_t> side(m.hexes.size());
   for (Index h = 0; h < m.num_hexes(); ++h) {
     Vec3 at = Vec3::Zero();
@@ -17,7 +17,12 @@ std::vector<std::uint8_t> first_sides(const HexMesh& m, const std::vector<std::a
         for (Index v : face_vertices(m.hexes[h], f)) at += m.points[v];
         ++faces;
       }
-    side[h] = surface.level(faces ? Vec3(at / (4.0 * faces)) : m.centroid(h)) > 0;
+    Vec3 g;
+    const double l = surface.level(faces ? Vec3(at / (4.0 * faces)) : m.centroid(h), g);
+    double size = 0;
+    if (tie_band > 0)
+      for (const auto& e : kHexEdges) size += (m.points[m.hexes[h][e[0]]] - m.points[m.hexes[h][e[1]]]).norm();
+    side[h] = l > 0 && !(tie_band > 0 && g.norm() > 0 && l / g.norm() <= tie_band * size / 12);
   }
   return side;
 }

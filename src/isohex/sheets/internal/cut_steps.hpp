@@ -40,20 +40,18 @@ struct Placer {
   const std::vector<contour::LevelSet>& levels;
   const BoundarySurface& tris;
   double tri_tol, reach, step;
+  const Aabb* domain = nullptr;  // places outside it are refused
 
   // Moves x onto everything in `keeps` at once: Newton steps, each the least step that zeroes
   // the linearised levels (a level set's L, or the signed distance to the plane of the nearest
   // triangle facing the keep's way), else by turns, else from a point of a volume's isosurface
   // found by bracketing. False if none settles within `reach`.
   bool place(Vec3& x, const Keeps& keeps) const;
+  bool place_anywhere(Vec3& x, const Keeps& keeps) const;
   bool newton(Vec3& x, const Keeps& keeps) const;
   // Alternating projections onto each of `keeps` in turn (slower than Newton steps, but they
   // settle where the triangles' planes change under the steps: a bumpy boundary).
   bool by_turns(Vec3& x, const Keeps& keeps) const;
-  // A point of `s` near x: the nearest sign change of L along the gradient's direction and the
-  // three axes, both ways, at distances doubling from step / 4 to 4 × step, bisected. For a
-  // scan's isosurface, where a plateau of values just off the isovalue sends Newton's steps far.
-  bool bracket(Vec3& x, const contour::LevelSet& s) const;
 };
 
 // The optimisers' constraint for a vertex: one or two things to keep to (two faces of the
@@ -62,9 +60,9 @@ BoundarySurface::Constraint constraint_of(const Keeps& k);
 
 // The sides of a cut (1 = inside) by the sign at each hex's centroid, or for a hex on the
 // boundary at the mean of its boundary faces' centres (the staircase then meets the boundary
-// where the surface does).
+// where the surface does); outside within `tie_band` (CutOptions::tie_band) of the surface.
 std::vector<std::uint8_t> first_sides(const HexMesh& m, const std::vector<std::array<Index, 6>>& nb,
-                                      const contour::LevelSet& surface);
+                                      const contour::LevelSet& surface, double tie_band);
 
 // The interior faces on an earlier cut's surface (all four vertices on it), as their two hexes,
 // with the side of the face's centre: both hexes must take it, or the face would be on the
