@@ -68,13 +68,35 @@ void run(const Args& a) {
   opt.optimize = !a.no_optimize;
   fmt::print("{}: {} hexes, {} vertices; {} cut(s), keep {}\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
              surfaces.size(), a.keep);
-  const CutResult r = cut(mesh, surfaces, opt);
+  CutResult r = cut(mesh, surfaces, opt);
+  nlohmann::json attempts;
+  if (a.tie_band == 0 && opt.optimize) {
+    // Hexes below 0.2: the cut again with a tie band (a surface through the middle of a layer of
+    // hexes, docs/cutting.md), the better kept; a second cut that fails keeps the first.
+    const CutAttemptScore first = cut_attempt_score(r.mesh);
+    if (first.below > 0) {
+      fmt::print("{} hexes below 0.2 (min SJ {:.4f}); the cut again with a tie band of {}\n", first.below, first.min_sj,
+                 kRetryTieBand);
+      opt.tie_band = kRetryTieBand;
+      attempts = {{"first", {{"below_0.2", first.below}, {"min_sj", first.min_sj}}}, {"kept", "first"}};
+      try {
+        CutResult again = cut(mesh, surfaces, opt);
+        const CutAttemptScore second = cut_attempt_score(again.mesh);
+        attempts["tie_band"] = {{"tie_band", kRetryTieBand}, {"below_0.2", second.below}, {"min_sj", second.min_sj}};
+        if (second.better_than(first)) r = std::move(again), attempts["kept"] = "tie_band";
+      } catch (const Error& e) {
+        attempts["tie_band"] = {{"tie_band", kRetryTieBand}, {"error", e.what()}};
+      }
+      fmt::print("kept the {} cut\n", attempts["kept"].get<std::string>() == "first" ? "first" : "second");
+    }
+  }
 
   nlohmann::json report;
   report["input"] = a.input;
   report["output"] = a.output;
   report["keep"] = a.keep;
   report["tie_band"] = a.tie_band;
+  if (!attempts.is_null()) report["attempts"] = attempts;
   nlohmann::json steps = nlohmann::json::array();
   for (std::size_t i = 0; i < r.steps.size(); ++i) {
     const CutStep& s = r.steps[i];
@@ -149,8 +171,8 @@ void register_cut(CLI::App& app) {
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--tie-band", a->tie_band,
                   "Hexes whose centre is within this fraction of their size of a surface count as outside it "
-                  "(default 0: the sign alone; e.g. 0.05 where a surface runs through the middle of a layer of "
-                  "slightly moved hexes)")
+                  "(default 0: the sign alone, and when hexes end below 0.2 the cut again with 0.05, the better "
+                  "kept; e.g. 0.05 where a surface runs through the middle of a layer of slightly moved hexes)")
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_flag("--no-optimize", a->no_optimize, "Place the new sheets on the surfaces but do not optimise");
   cmd->add_option("--json", a->json, "Write a JSON report");

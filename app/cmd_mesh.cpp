@@ -294,9 +294,8 @@ void run(const Args& a) {
     cut_and_optimise(0);
     const CutAttemptScore first = cut_attempt_score(out.mesh);
     if (first.below > 0) {
-      constexpr double kTieBand = 0.05;
       fmt::print("cut: {} hexes below 0.2 after the optimisation (min SJ {:.4f}); again with the hexes within {} of "
-                 "their size of the cut outside\n", first.below, first.min_sj, kTieBand);
+                 "their size of the cut outside\n", first.below, first.min_sj, kRetryTieBand);
       // Swaps the first attempt's results out (and back if it stays the better).
       const auto exchange = [&](CutAttempt& k) {
         std::swap(out.mesh, k.mesh), std::swap(out.vertex_place, k.place), std::swap(cut, k.cut);
@@ -311,13 +310,13 @@ void run(const Args& a) {
       exchange(kept);
       out.mesh = pillowed;
       out.vertex_place = place;
-      cut_and_optimise(kTieBand);
+      cut_and_optimise(kRetryTieBand);
       const CutAttemptScore second = cut_attempt_score(out.mesh);
-      const bool better = second.below < first.below || (second.below == first.below && second.min_sj > first.min_sj);
+      const bool better = second.better_than(first);
       fmt::print("cut: {} below 0.2 with the tie band (min SJ {:.4f}); the {} kept\n", second.below, second.min_sj,
                  better ? "second" : "first");
       nlohmann::json attempts = {{"first", {{"below_0.2", first.below}, {"min_sj", first.min_sj}}},
-                                 {"tie_band", {{"tie_band", kTieBand}, {"below_0.2", second.below}, {"min_sj", second.min_sj}}},
+                                 {"tie_band", {{"tie_band", kRetryTieBand}, {"below_0.2", second.below}, {"min_sj", second.min_sj}}},
                                  {"kept", better ? "tie_band" : "first"}};
       if (!better) exchange(kept);
       cutting["attempts"] = std::move(attempts);

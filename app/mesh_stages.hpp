@@ -94,7 +94,12 @@ nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, 
 struct CutAttemptScore {
   std::size_t below = 0;
   double min_sj = 2;
+  [[nodiscard]] bool better_than(const CutAttemptScore& o) const {
+    return below < o.below || (below == o.below && min_sj > o.min_sj);
+  }
 };
+/// The tie band of the second attempt (CutOptions::tie_band).
+inline constexpr double kRetryTieBand = 0.05;
 CutAttemptScore cut_attempt_score(const HexMesh& mesh);
 
 /// One attempt's results, kept aside while the next runs.

@@ -386,6 +386,40 @@ TEST(Cut, CommandLine) {
   EXPECT_NE(out.find("misses the mesh"), std::string::npos) << out;
 }
 
+// A plane meeting the face x = 0 of the 12³ cube at 20°: by the signs alone a hex is left
+// inverted at the wedge's tip; the second cut, with a tie band, leaves none. The hexes at the
+// corner of the plane and the faces x = 0 and y = 2 cannot do better than 0.109: a hex corner
+// there has its three edges on the three creases, whose unit directions (0, 0, 1),
+// (0, -0.2, 0.3) / |.|, (0.2, 0, -1) / |.| have that determinant.
+TEST(Cut, CommandLineCutsAgainWithATieBand) {
+  const auto dir = scratch_dir();
+  ASSERT_EQ(run_cli("generate box -n 12 --size 2 -o " + quote(dir / "cube12.vtu")), 0);
+  std::string out;
+  ASSERT_EQ(run_cli("cut " + quote(dir / "cube12.vtu") + " -o " + quote(dir / "wedge.vtu") +
+                        " --surface 'plane(0.5,0.5,0.5, 1,0.3,0.2)' --json " + quote(dir / "wedge.json"),
+                    &out),
+            0)
+      << out;
+  const auto j = nlohmann::json::parse(io::read_file(dir / "wedge.json"));
+  ASSERT_TRUE(j.contains("attempts")) << out;
+  EXPECT_EQ(j["attempts"]["kept"], "tie_band");
+  EXPECT_LT(j["attempts"]["first"]["min_sj"].get<double>(), 0.01);
+  EXPECT_EQ(j["quality"]["inverted"].get<int>(), 0);
+  EXPECT_EQ(j["validity"]["not_valid_inside"].get<int>(), 0);
+  const Vec3 a(0, 0, 1), b = Vec3(0, -0.2, 0.3).normalized(), c = Vec3(0.2, 0, -1).normalized();
+  const double bound = std::abs(a.dot(b.cross(c)));
+  EXPECT_NEAR(j["quality"]["min"].get<double>(), bound, 2e-3);
+  // Asked for by hand, the tie band runs once.
+  ASSERT_EQ(run_cli("cut " + quote(dir / "cube12.vtu") + " -o " + quote(dir / "wedge2.vtu") +
+                        " --surface 'plane(0.5,0.5,0.5, 1,0.3,0.2)' --tie-band 0.05 --json " + quote(dir / "wedge2.json"),
+                    &out),
+            0)
+      << out;
+  const auto k = nlohmann::json::parse(io::read_file(dir / "wedge2.json"));
+  EXPECT_FALSE(k.contains("attempts"));
+  EXPECT_EQ(k["quality"]["min"], j["quality"]["min"]);
+}
+
 namespace {
 
 // The boundary edges whose two quads' normals differ by more than `degrees`: (edge, angle).
