@@ -73,7 +73,7 @@ void run(const Args& a) {
   if (a.tie_band == 0 && opt.optimize) {
     // Hexes below 0.2: the cut again with a tie band (a surface through the middle of a layer of
     // hexes, docs/cutting.md), the better kept; a second cut that fails keeps the first.
-    const CutAttemptScore first = cut_attempt_score(r.mesh);
+    const RoundScore first = mesh_score(r.mesh);
     if (first.below > 0) {
       fmt::print("{} hexes below 0.2 (min SJ {:.4f}); the cut again with a tie band of {}\n", first.below, first.min_sj,
                  kRetryTieBand);
@@ -81,9 +81,9 @@ void run(const Args& a) {
       attempts = {{"first", {{"below_0.2", first.below}, {"min_sj", first.min_sj}}}, {"kept", "first"}};
       try {
         CutResult again = cut(mesh, surfaces, opt);
-        const CutAttemptScore second = cut_attempt_score(again.mesh);
+        const RoundScore second = mesh_score(again.mesh);
         attempts["tie_band"] = {{"tie_band", kRetryTieBand}, {"below_0.2", second.below}, {"min_sj", second.min_sj}};
-        if (second.better_than(first)) r = std::move(again), attempts["kept"] = "tie_band";
+        if (first.worse_than(second)) r = std::move(again), attempts["kept"] = "tie_band";
       } catch (const Error& e) {
         attempts["tie_band"] = {{"tie_band", kRetryTieBand}, {"error", e.what()}};
       }

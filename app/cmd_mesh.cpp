@@ -292,7 +292,7 @@ void run(const Args& a) {
     const HexMesh pillowed = out.mesh;
     const std::vector<std::int8_t> place = out.vertex_place;
     cut_and_optimise(0);
-    const CutAttemptScore first = cut_attempt_score(out.mesh);
+    const RoundScore first = mesh_score(out.mesh);
     if (first.below > 0) {
       fmt::print("cut: {} hexes below 0.2 after the optimisation (min SJ {:.4f}); again with the hexes within {} of "
                  "their size of the cut outside\n", first.below, first.min_sj, kRetryTieBand);
@@ -311,8 +311,8 @@ void run(const Args& a) {
       out.mesh = pillowed;
       out.vertex_place = place;
       cut_and_optimise(kRetryTieBand);
-      const CutAttemptScore second = cut_attempt_score(out.mesh);
-      const bool better = second.better_than(first);
+      const RoundScore second = mesh_score(out.mesh);
+      const bool better = first.worse_than(second);
       fmt::print("cut: {} below 0.2 with the tie band (min SJ {:.4f}); the {} kept\n", second.below, second.min_sj,
                  better ? "second" : "first");
       nlohmann::json attempts = {{"first", {{"below_0.2", first.below}, {"min_sj", first.min_sj}}},

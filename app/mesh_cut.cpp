@@ -1,9 +1,7 @@
 // isohex mesh --cut: the cut stage over the pillowed mesh, its report, and the score by which
-// a second attempt (a tie band) is kept or not (see mesh_stages.hpp).
+// (see mesh_stages.hpp).
 #include "mesh_stages.hpp"
 #include "isohex/mesh/topology.hpp"
-#include "isohex/quality/hex_quality.hpp"
-#include "isohex/quality/jacobian_bounds.hpp"
 #include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
@@ -72,16 +70,6 @@ nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, 
   stage.constraints = std::move(r.constraints);
   mesh = std::move(r.mesh);
   return {{"keep", cut_keep_name(keep)}, {"cuts", steps}};
-}
-
-CutAttemptScore cut_attempt_score(const HexMesh& mesh) {
-  CutAttemptScore s;
-  for (const double q : certified_scaled_jacobians(mesh)) {
-    const double v = is_degenerate(q) ? -1.0 : q;
-    s.below += v < kQuestionableSJ;
-    s.min_sj = std::min(s.min_sj, v);
-  }
-  return s;
 }
 
 void report_cut_distances(const CutStage& stage, const HexMesh& mesh, nlohmann::json& cutting) {

@@ -172,18 +172,6 @@ nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& 
 
 namespace {
 
-// What a release round is judged by, worst first: hexes below 0.2 (certified scaled
-// Jacobian), the smallest of those, hexes with a jacobian ratio below 0.1, the smallest ratio.
-struct RoundScore {
-  std::size_t below = 0, poor = 0;
-  double min_sj = 2, min_ratio = 2;
-  [[nodiscard]] bool worse_than(const RoundScore& o) const {
-    if (below != o.below) return below > o.below;
-    if (min_sj != o.min_sj) return min_sj < o.min_sj;
-    if (poor != o.poor) return poor > o.poor;
-    return min_ratio < o.min_ratio;
-  }
-};
 
 // Per hex the lower of the certified scaled Jacobian and twice the jacobian ratio (what the
 // rounds release for: a ratio of 0.1 ranks with a scaled Jacobian of 0.2), and the score.
@@ -347,6 +335,12 @@ nlohmann::json rounds_in_band(HexMesh& mesh, BoundarySurface& surface, double ba
 }
 
 }  // namespace
+
+RoundScore mesh_score(const HexMesh& mesh) {
+  RoundScore s;
+  round_ranks(mesh, s);
+  return s;
+}
 
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& o,
                               std::size_t* reattached, bool* poor_left, bool widen_if_poor) {

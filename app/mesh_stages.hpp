@@ -53,6 +53,21 @@ ProgressCallback progress_printer(std::FILE* out);
 /// reason; shape; worst). Returns the JSON facts ("untangle", "shape", "worst").
 nlohmann::json run_optimisation(HexMesh& mesh, const std::vector<std::uint8_t>& fixed, const OptimizeOptions& options);
 
+// What a release round is judged by, worst first: hexes below 0.2 (certified scaled
+// Jacobian), the smallest of those, hexes with a jacobian ratio below 0.1, the smallest ratio.
+struct RoundScore {
+  std::size_t below = 0, poor = 0;
+  double min_sj = 2, min_ratio = 2;
+  [[nodiscard]] bool worse_than(const RoundScore& o) const {
+    if (below != o.below) return below > o.below;
+    if (min_sj != o.min_sj) return min_sj < o.min_sj;
+    if (poor != o.poor) return poor > o.poor;
+    return min_ratio < o.min_ratio;
+  }
+};
+/// The score of the whole mesh (the release rounds' and the cut attempts' judge).
+RoundScore mesh_score(const HexMesh& mesh);
+
 /// After a first run_optimisation() with `surface`: up to five rounds that release the
 /// boundary vertices of the hexes still below 0.2 (or with a jacobian ratio below 0.1), and of
 /// the hexes up to 3 vertex rings around them, into a band of half-width `band` (world
@@ -89,18 +104,9 @@ nlohmann::json cut_stage(HexMesh& mesh, std::vector<std::int8_t>& vertex_place, 
                          const std::vector<Shape>& shapes, const std::vector<contour::LevelSet>& isosurfaces, CutKeep keep,
                          bool terminal, CutStage& stage, double tie_band = 0);
 
-/// How the cut and the optimisation after it ended, by the certified scaled Jacobian: hexes
-/// below 0.2 and the minimum (`isohex mesh --cut` tries a tie band when the first leaves some).
-struct CutAttemptScore {
-  std::size_t below = 0;
-  double min_sj = 2;
-  [[nodiscard]] bool better_than(const CutAttemptScore& o) const {
-    return below < o.below || (below == o.below && min_sj > o.min_sj);
-  }
-};
-/// The tie band of the second attempt (CutOptions::tie_band).
+/// The tie band of the second cut (CutOptions::tie_band), tried when the first leaves hexes below
+/// 0.2; the better of the two by RoundScore is kept.
 inline constexpr double kRetryTieBand = 0.05;
-CutAttemptScore cut_attempt_score(const HexMesh& mesh);
 
 /// One attempt's results, kept aside while the next runs.
 struct CutAttempt {

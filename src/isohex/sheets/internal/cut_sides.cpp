@@ -17,12 +17,17 @@ std::vector<std::uint8_t> first_sides(const HexMesh& m, const std::vector<std::a
         for (Index v : face_vertices(m.hexes[h], f)) at += m.points[v];
         ++faces;
       }
+    const Vec3 p = faces ? Vec3(at / (4.0 * faces)) : m.centroid(h);
+    if (tie_band <= 0) {
+      side[h] = surface.level(p) > 0;
+      continue;
+    }
+    // Within tie_band × the hex's mean edge of the surface (|L| / |∇L|): outside.
     Vec3 g;
-    const double l = surface.level(faces ? Vec3(at / (4.0 * faces)) : m.centroid(h), g);
+    const double l = surface.level(p, g);
     double size = 0;
-    if (tie_band > 0)
-      for (const auto& e : kHexEdges) size += (m.points[m.hexes[h][e[0]]] - m.points[m.hexes[h][e[1]]]).norm();
-    side[h] = l > 0 && !(tie_band > 0 && g.norm() > 0 && l / g.norm() <= tie_band * size / 12);
+    for (const auto& e : kHexEdges) size += (m.points[m.hexes[h][e[0]]] - m.points[m.hexes[h][e[1]]]).norm();
+    side[h] = l > 0 && !(g.norm() > 0 && l / g.norm() <= tie_band * size / 12);
   }
   return side;
 }

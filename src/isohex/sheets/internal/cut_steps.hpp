@@ -45,7 +45,8 @@ struct Placer {
   // Moves x onto everything in `keeps` at once: Newton steps, each the least step that zeroes
   // the linearised levels (a level set's L, or the signed distance to the plane of the nearest
   // triangle facing the keep's way), else by turns, else from a point of a volume's isosurface
-  // found by bracketing. False if none settles within `reach`.
+  // found by bracketing. False if none settles within `reach`, or (place()) it lies outside
+  // `domain`; x is unchanged then.
   bool place(Vec3& x, const Keeps& keeps) const;
   bool place_anywhere(Vec3& x, const Keeps& keeps) const;
   bool newton(Vec3& x, const Keeps& keeps) const;
