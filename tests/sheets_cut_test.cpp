@@ -218,6 +218,32 @@ TEST(Cut, PlaneThroughTheMiddleOfALayer) {
   EXPECT_GT(min_sj(r.mesh), 0.5);
 }
 
+// A plate one hex thick standing on a face of the box (cthead's head rest on the scan's bottom
+// slice): its front and back are one surface, so the edge across its bottom has both ends on
+// that surface and on the box face, yet it is not on their curve. A cut across the plate moves
+// nothing there; treated as a curve edge, its ends went to one side one after another along the
+// whole bottom (cthead h 4, sagittal plane: 14 hexes flattened to SJ 0).
+TEST(Cut, PlaneAcrossAPlateOnABoxFace) {
+  const Aabb domain{Vec3(0, 0, 0), Vec3(8, 0.5, 4)};
+  const HexMesh plate = box_mesh(16, 1, 8, domain.lo, domain.hi);
+  CutOptions o;
+  o.feature_degrees = 180;
+  o.boundary = {contour::LevelSet(std::make_shared<const Shape>(parse_shape("box(-1,0,-1, 9,0.5,5)")), 10.0),
+                contour::LevelSet(domain, 4)};  // the plate's skin and the box face z = 0
+  o.domain = domain;
+  for (const double x : {4.1, 3.8}) {
+    SCOPED_TRACE(x);
+    const CutResult r = cut(plate, {Shape::plane(Vec3(x, 0, 0), Vec3(1, 0, 0))}, o);
+    EXPECT_EQ(r.steps[0].moved_across, 0u);
+    EXPECT_EQ(r.surface_quads[0].size(), 8u);  // the plate's section: one column of quads
+    EXPECT_EQ(r.steps[0].corner_vertices, 2u);  // the plane, the plate's two faces and z = 0
+    EXPECT_LE(r.max_distance[0], 1e-9);
+    EXPECT_TRUE(validate(r.mesh).valid());
+    EXPECT_EQ(below(r.mesh, 0.2), 0u);
+    EXPECT_EQ(not_certified(r.mesh), 0u);
+  }
+}
+
 // Other sizes and shapes, and a bumpy (jittered) cube, stay valid with nothing below 0.2.
 TEST(Cut, OtherCellSizesAndShapes) {
   struct Case {

@@ -148,7 +148,7 @@ struct Cutting {
     for (int round = 0; round < 20; ++round) {
       const std::size_t unreachable =
           unreachable_to_one_side(m, inc, side, keeps, cut_id, placer(), next, locked);
-      if (unreachable + doubled_curve_ends(inc, edges, keeps, cos_limit, next, locked) == 0) break;
+      if (unreachable + doubled_curve_ends(m, levels, inc, edges, keeps, cos_limit, next, locked) == 0) break;
       for (std::size_t h = 0; h < side.size(); ++h) step.moved_across += next[h] != side[h];
       side = std::move(next);
       settle_sides(m, nb, earlier, locked, side, step.moved_across);

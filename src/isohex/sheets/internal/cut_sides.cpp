@@ -106,21 +106,44 @@ std::size_t unreachable_to_one_side(const HexMesh& m, const Incidence& inc, cons
 
 namespace {
 
-// How many keeps two vertices share (a level set, or a face of the input's triangles facing alike).
-int shared_keeps(const Keeps& a, const Keeps& b, double cos_limit) {
-  int n = 0;
-  for (const Keep& x : a)
-    n += std::any_of(b.begin(), b.end(), [&](const Keep& y) {
-      return x.surface == y.surface && (x.surface >= 0 || x.facing.dot(y.facing) >= cos_limit);
-    });
-  return n;
+// Whether vertex v keeps to `keep` (a level set, or a face of the input's triangles facing alike).
+bool keeps_to(const Keeps& v, const Keep& keep, double cos_limit) {
+  return std::any_of(v.begin(), v.end(), [&](const Keep& y) {
+    return keep.surface == y.surface && (keep.surface >= 0 || keep.facing.dot(y.facing) >= cos_limit);
+  });
+}
+
+// Whether the edge a-b runs along a curve of two surfaces its ends share (a level set, or a
+// face of the input's triangles facing alike): its midpoint is on both, within a quarter of the edge's length (|L| / |grad L|; a face of the input's triangles
+// counts as on). Not an edge across a patch between two branches of the curve: the bottom of a
+// plate thinner than a cell standing on a face of the box has both ends on the plate's skin and
+// on the box face, its middle inside the plate; no cut point collapses such an edge, and its
+// ends, sent to one side, would drag the next such edge with them along the whole plate
+// (cthead h 4, the sagittal plane: 14 hexes flattened to SJ 0).
+bool along_curve(const Vec3& a, const Vec3& b, const Keeps& ka, const Keeps& kb,
+                 const std::vector<contour::LevelSet>& levels, double cos_limit) {
+  const Vec3 mid = 0.5 * (a + b);
+  const double reach = 0.25 * (b - a).norm();
+  int on = 0;
+  for (const Keep& k : ka) {
+    if (!keeps_to(kb, k, cos_limit)) continue;
+    if (k.surface < 0) {
+      ++on;
+      continue;
+    }
+    const contour::LevelSet& s = levels[static_cast<std::size_t>(k.surface)];
+    Vec3 g;
+    const double l = std::abs(s.level(mid, g));
+    on += l <= 10 * s.tolerance() || l <= reach * g.norm();
+  }
+  return on >= 2;
 }
 
 }  // namespace
 
-std::size_t doubled_curve_ends(const Incidence& inc, const std::vector<std::array<Index, 2>>& edges,
-                               const std::vector<Keeps>& keeps, double cos_limit, std::vector<std::uint8_t>& side,
-                               std::vector<std::uint8_t>& locked) {
+std::size_t doubled_curve_ends(const HexMesh& m, const std::vector<contour::LevelSet>& levels, const Incidence& inc,
+                               const std::vector<std::array<Index, 2>>& edges, const std::vector<Keeps>& keeps,
+                               double cos_limit, std::vector<std::uint8_t>& side, std::vector<std::uint8_t>& locked) {
   // For vertex v: the side its hexes would join and how many change; -1 if locked both ways
   // or already on one side.
   const auto plan = [&](Index v, std::uint8_t& to) {
@@ -136,7 +159,9 @@ std::size_t doubled_curve_ends(const Incidence& inc, const std::vector<std::arra
   };
   std::size_t moved = 0;
   for (const auto& [a, b] : edges) {
-    if (keeps[a].size() < 2 || keeps[b].size() < 2 || shared_keeps(keeps[a], keeps[b], cos_limit) < 2) continue;
+    if (keeps[a].size() < 2 || keeps[b].size() < 2 ||
+        !along_curve(m.points[a], m.points[b], keeps[a], keeps[b], levels, cos_limit))
+      continue;
     std::uint8_t to_a = 0, to_b = 0;
     const int na = plan(a, to_a), nb = plan(b, to_b);
     if (na < 0 || nb < 0) continue;

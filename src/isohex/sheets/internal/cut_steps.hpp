@@ -96,9 +96,10 @@ std::size_t unreachable_to_one_side(const HexMesh& m, const Incidence& inc, cons
 // whose two ends are both interface vertices: both would go to the one point where the cut
 // crosses the curve and collapse the edge. One end's hexes join one side (the side of those
 // locked before, else its majority) and are locked there; the end that moves fewer hexes.
-// Returns how many ends moved.
-std::size_t doubled_curve_ends(const Incidence& inc, const std::vector<std::array<Index, 2>>& edges,
-                               const std::vector<Keeps>& keeps, double cos_limit, std::vector<std::uint8_t>& side,
+// An edge is on the curve when its midpoint is on both surfaces (within a quarter of its length;
+// not an edge across a patch between two branches of the curve). Returns how many ends moved.
+std::size_t doubled_curve_ends(const HexMesh& m, const std::vector<contour::LevelSet>& levels, const Incidence& inc,
+                               const std::vector<std::array<Index, 2>>& edges, const std::vector<Keeps>& keeps, double cos_limit, std::vector<std::uint8_t>& side,
                                std::vector<std::uint8_t>& locked);
 
 }  // namespace isohex::internal
