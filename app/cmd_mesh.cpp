@@ -339,7 +339,16 @@ void run(const Args& a) {
   }
   const double check_time = seconds_since(t);
   t = Clock::now();
-  io::write_mesh(a.output, out.mesh);
+  {
+    // Per vertex, where the pipeline left it: "surface" the index of the region surface it lies
+    // on (-1 inside, -2 on the domain box), "released" 1 if it was released into the band.
+    io::DataField surface{"surface", std::vector<double>(out.mesh.points.size(), contour::kInteriorVertex)};
+    io::DataField loose{"released", std::vector<double>(out.mesh.points.size(), 0.0)};
+    for (std::size_t v = 0; v < out.vertex_place.size() && v < surface.values.size(); ++v)
+      surface.values[v] = out.vertex_place[v];
+    for (std::size_t v = 0; v < released.size() && v < loose.values.size(); ++v) loose.values[v] = released[v];
+    write_result(a.output, out.mesh, {std::move(surface), std::move(loose)});
+  }
   const double write_time = seconds_since(t);
 
   fmt::print("mesh: {} hexes, {} vertices ({} on surfaces, {} on the domain box), {} boundary quads\n",
@@ -588,7 +597,11 @@ void register_mesh(CLI::App& app) {
                   "successive cuts");
   cmd->add_option("--keep", a->keep, "With --cut / --cut-iso: both (default: the inside a new block), inside or outside")
       ->check(CLI::IsMember({"both", "inside", "outside"}));
-  cmd->add_option("-o,--output", a->output, fmt::format("Output mesh ({})", io::kMeshExtensions))->required();
+  cmd->add_option("-o,--output", a->output,
+                  fmt::format("Output mesh ({}); a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio, per "
+                              "vertex surface (index, -1 inside, -2 domain box) and released (0/1)",
+                              io::kMeshExtensions))
+      ->required();
   cmd->add_option("--json", a->json, "Write the report as JSON");
   cmd->add_option("--report", a->report,
                   "Write a report folder: report.json, quality histograms per stage (SVG, PNG), report.html with a 3D "

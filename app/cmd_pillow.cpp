@@ -32,7 +32,7 @@ void run(const Args& a) {
   const PillowResult r = pillow(mesh, set, opt);
   const std::size_t multi_after = count_multi_boundary_hexes(r.mesh);
   const auto shrink_hexes = std::count_if(set.begin(), set.end(), [](std::uint8_t f) { return f != 0; });
-  io::write_mesh(a.output, r.mesh);
+  write_result(a.output, r.mesh);
 
   fmt::print("{}: {} hexes, {} vertices; shrink set '{}': {} hexes\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
              a.shrink_set, shrink_hexes);
@@ -89,7 +89,7 @@ void register_pillow(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("pillow", "Insert a dual sheet around a shrink set by pillowing");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp)")->required();
-  cmd->add_option("-o,--output", a->output, "Pillowed mesh")->required();
+  cmd->add_option("-o,--output", a->output, "Pillowed mesh (a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio)")->required();
   cmd->add_option("--shrink-set", a->shrink_set,
                   "boundary (default: a sheet along every boundary component), block:ID, region:EXPR (hexes whose "
                   "centroid is inside the shape) or ids:FILE (one hex id per line)");

@@ -41,7 +41,7 @@ void run(const Args& a) {
                                            mesh.num_hexes(), a.input));
   const RefineResult r = refine(mesh, marked_vertices_of(mesh, ids));
   const double sj_before = min_scaled_jacobian(mesh), sj_after = min_scaled_jacobian(r.mesh);
-  io::write_mesh(a.output, r.mesh);
+  write_result(a.output, r.mesh);
 
   fmt::print("{}: {} hexes, {} vertices; selection '{}': {} hexes\n", a.input, mesh.num_hexes(), mesh.num_vertices(),
              a.hexes, ids.size());
@@ -82,7 +82,7 @@ void register_refine(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("refine", "Refine hexes locally, conformingly, by 3-refinement templates");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp .exo .msh)")->required();
-  cmd->add_option("-o,--output", a->output, "Refined mesh")->required();
+  cmd->add_option("-o,--output", a->output, "Refined mesh (a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio)")->required();
   cmd->add_option("--hexes", a->hexes,
                   "Hexes to refine: all (default), block:ID, region:EXPR (hexes whose centroid is inside the shape, "
                   "syntax of 'isohex volume shape') or ids:FILE (one hex id per line); their 8 vertices are marked");

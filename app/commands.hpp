@@ -24,6 +24,7 @@ int& exit_code();
 }  // namespace isohex::cli
 
 #include "isohex/volume/volume_io.hpp"
+#include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/hex_mesh.hpp"
 #include "isohex/quality/summary.hpp"
 
@@ -51,6 +52,11 @@ struct VolumeReadArgs {
 
 /// Reads a mesh for a command; prints how many non-hex cells were dropped, if any.
 HexMesh load_mesh(const std::string& file, bool skip_non_hex);
+
+/// Writes a mesh a command made: a .vtu or .vtk carries each hex's quality
+/// (io::quality_fields: "scaled_jacobian", "jacobian_ratio") and `point_fields`, so that a
+/// viewer colours the worst hexes without recomputing them.
+void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::DataField> point_fields = {});
 
 /// Min, mean, inverted, below 0.2 and degenerate of a scaled-Jacobian summary (the reports of
 /// `isohex smooth` and `isohex cut`).

@@ -25,6 +25,17 @@ HexMesh load_mesh(const std::string& file, bool skip_non_hex) {
   return mesh;
 }
 
+void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::DataField> point_fields) {
+  std::string ext = std::filesystem::path(file).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  io::WriteOptions options;
+  if (ext == ".vtu" || ext == ".vtk") {  // the other formats have no place for them
+    options.cell_fields = io::quality_fields(mesh);
+    options.point_fields = std::move(point_fields);
+  }
+  io::write_mesh(file, mesh, options);
+}
+
 nlohmann::json quality_json(const MetricSummary& s) {
   return {{"min", s.min},
           {"mean", s.mean},

@@ -1,5 +1,6 @@
 // `isohex mesh --shape EXPR --features sheets`: a CSG shape meshed by cuts, every crease on a
 // string of edges (sheets/csg_cuts.hpp), instead of sampling it and contouring.
+#include "commands.hpp"
 #include "mesh_stages.hpp"
 
 #include "isohex/io/mesh_io.hpp"
@@ -45,7 +46,7 @@ nlohmann::json mesh_shape_by_cuts(const std::string& expression, double cell_siz
   fmt::print("  scaled Jacobian: min {:.4f}  mean {:.4f}\n  inverted (< 0): {}   questionable (< 0.2): {}   degenerate: {}\n",
              q.min, q.mean, q.inverted, q.questionable, q.degenerate);
   fmt::print("  {}\n", describe(validity));
-  io::write_mesh(output, r.mesh);
+  write_result(output, r.mesh);
   inverted_left = q.inverted + q.degenerate;
   return {{"features", "sheets"},
           {"pieces", pieces},

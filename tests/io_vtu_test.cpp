@@ -3,6 +3,8 @@
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
 #include "isohex/io/mesh_io.hpp"
+#include "isohex/mesh/generate.hpp"
+#include "isohex/quality/hex_quality.hpp"
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -524,4 +526,53 @@ TEST(VtuWrite, FailedWriteLeavesNoFile) {
   EXPECT_THROW(io::write_vtu(dir / "out.vtu", bad_id, {}), Error);
   EXPECT_EQ(io::read_file(dir / "out.vtu"), before);
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+}
+
+// Fields written beside the mesh (.vtu and .vtk, binary and ASCII): the readers skip them and
+// read the same mesh; a field that does not fit the mesh is refused before anything is written.
+TEST(MeshFields, WrittenBesideTheMeshAndSkippedByTheReaders) {
+  const fs::path dir = scratch_dir();
+  HexMesh m = box_mesh(3, 2, 2);
+  jitter(m, 0.02, 5);
+  m.blocks.assign(m.hexes.size(), 4);
+  io::WriteOptions o;
+  o.cell_fields = io::quality_fields(m);
+  ASSERT_EQ(o.cell_fields.size(), 2u);
+  EXPECT_EQ(o.cell_fields[0].name, "scaled_jacobian");
+  for (Index h = 0; h < m.num_hexes(); ++h) EXPECT_EQ(o.cell_fields[0].values[h], scaled_jacobian(m.corners(h)));
+  o.point_fields = {{"height", {}}};
+  for (const Vec3& p : m.points) o.point_fields[0].values.push_back(p.z());
+  for (const bool binary : {true, false})
+    for (const char* ext : {".vtu", ".vtk"}) {
+      SCOPED_TRACE(std::string(ext) + (binary ? " binary" : " ascii"));
+      o.binary = binary;
+      const fs::path f = dir / (std::string("fields") + (binary ? "_b" : "_a") + ext);
+      io::write_mesh(f, m, o);
+      const HexMesh back = io::read_mesh(f);
+      EXPECT_EQ(back.hexes, m.hexes);
+      EXPECT_EQ(back.blocks, m.blocks);
+      ASSERT_EQ(back.points.size(), m.points.size());
+      for (std::size_t v = 0; v < m.points.size(); ++v) EXPECT_EQ(back.points[v], m.points[v]);
+    }
+  const auto refused = [&](io::WriteOptions bad, const std::string& says) {
+    const fs::path f = dir / "refused.vtu";
+    fs::remove(f);
+    try {
+      io::write_mesh(f, m, bad);
+      ADD_FAILURE() << "no error for " << says;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("refused.vtu"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(f));
+  };
+  io::WriteOptions bad = o;
+  bad.cell_fields[1].values.pop_back();
+  refused(bad, "has 11 values for 12 hexes");
+  bad = o;
+  bad.point_fields[0].name = "two words";
+  refused(bad, "is not letters, digits and '_'");
+  bad = o;
+  bad.cell_fields[0].name = "block";
+  refused(bad, "two arrays named 'block'");
 }

@@ -35,7 +35,7 @@ import numpy as np
 import vtk
 from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 from oracle_support import check, finish, oracle_args, parse_msh22
-from vtk_support import hex_quality, read_vtu
+from vtk_support import hex_quality, read_vtu, trilinear
 
 SPHERES = [((2, 2, 2), 1.2), ((2, 0.8, 1.0), 0.75), ((1.0, 2, 1.5), 0.7)]
 
@@ -202,20 +202,6 @@ def meshed(cmd, what):
     hexes = vtk_to_numpy(grid.GetCells().GetConnectivityArray()).reshape(-1, 8)
     pts = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
     return grid, blocks, hexes, pts
-
-
-def trilinear(vol, spacing, p):
-    """The trilinear interpolant of vol[z, y, x] at world points p (N x 3), origin 0."""
-    g = p / spacing
-    i = np.clip(np.floor(g).astype(int), 0, np.array(vol.shape[::-1]) - 2)
-    f = g - i
-    out = np.zeros(len(p))
-    for dz in (0, 1):
-        for dy in (0, 1):
-            for dx in (0, 1):
-                w = (f[:, 0] if dx else 1 - f[:, 0]) * (f[:, 1] if dy else 1 - f[:, 1]) * (f[:, 2] if dz else 1 - f[:, 2])
-                out += w * vol[i[:, 2] + dz, i[:, 1] + dy, i[:, 0] + dx]
-    return out
 
 
 def cthead_mesh(cli, raw):

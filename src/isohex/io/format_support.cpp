@@ -2,6 +2,8 @@
 
 #include "isohex/error.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <ostream>
 
@@ -36,6 +38,35 @@ std::string printable(std::string_view token) {
   return out;
 }
 
+namespace {
+
+// Letters, digits and '_', starting with a letter, at most 32 characters: a name every format
+// takes as it is (an Abaqus surface, an Exodus set, a VTK array).
+bool is_identifier(const std::string& name) {
+  return !name.empty() && name.size() <= 32 && std::isalpha(static_cast<unsigned char>(name[0])) &&
+         std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+}
+
+}  // namespace
+
+void check_fields_for_writing(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options) {
+  std::vector<std::string> names = {"block", "fixed"};
+  for (const auto* fields : {&options.cell_fields, &options.point_fields})
+    for (const DataField& f : *fields) {
+      const bool cell = fields == &options.cell_fields;
+      const std::size_t want = cell ? mesh.hexes.size() : mesh.points.size();
+      if (!is_identifier(f.name))
+        throw Error(fmt::format("{}: cannot write: field name '{}' is not letters, digits and '_' starting with a letter",
+                                file.string(), f.name));
+      if (std::find(names.begin(), names.end(), f.name) != names.end())
+        throw Error(fmt::format("{}: cannot write: two arrays named '{}'", file.string(), f.name));
+      names.push_back(f.name);
+      if (f.values.size() != want)
+        throw Error(fmt::format("{}: cannot write: {} field '{}' has {} values for {} {}", file.string(),
+                                cell ? "cell" : "point", f.name, f.values.size(), want, cell ? "hexes" : "vertices"));
+    }
+}
+
 void check_mesh_for_writing(const std::filesystem::path& file, const HexMesh& mesh) {
   const auto fail = [&](const std::string& what) {
     throw Error(fmt::format("{}: cannot write: {}", file.string(), what));
@@ -52,11 +83,7 @@ void check_mesh_for_writing(const std::filesystem::path& file, const HexMesh& me
       if (id < 0 || static_cast<std::size_t>(id) >= nv)
         fail(fmt::format("hex {} has vertex id {} out of range [0, {})", h, id, nv));
   for (const FaceSet& fs : mesh.face_sets) {
-    const bool name_ok = !fs.name.empty() && fs.name.size() <= 32 && std::isalpha(static_cast<unsigned char>(fs.name[0])) &&
-                         std::all_of(fs.name.begin(), fs.name.end(), [](char c) {
-                           return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-                         });
-    if (!name_ok) fail(fmt::format("face set name '{}' is not letters, digits and '_' starting with a letter", fs.name));
+    if (!is_identifier(fs.name)) fail(fmt::format("face set name '{}' is not letters, digits and '_' starting with a letter", fs.name));
     for (const auto& [h, f] : fs.faces)
       if (h < 0 || h >= mesh.num_hexes() || f < 0 || f > 5)
         fail(fmt::format("face set {} has face ({}, {}) out of range", fs.name, h, f));

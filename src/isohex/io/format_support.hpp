@@ -5,6 +5,7 @@
 /// buffered text / big-endian output.
 
 #include "isohex/io/big_endian.hpp"
+#include "isohex/io/mesh_io.hpp"
 #include "isohex/mesh/hex_mesh.hpp"
 
 #include <fmt/format.h>
@@ -32,6 +33,11 @@ std::string printable(std::string_view token);
 /// Throws isohex::Error naming `file` unless `mesh` can be written as it is: every hex
 /// vertex id in range, finite coordinates, `blocks`/`fixed` empty or one per hex/vertex.
 void check_mesh_for_writing(const std::filesystem::path& file, const HexMesh& mesh);
+
+/// Throws isohex::Error naming `file` for a WriteOptions field whose name is not letters,
+/// digits and '_' (starting with a letter), clashes with another or with "block" / "fixed", or
+/// whose values do not match the hexes (cell fields) or vertices (point fields) one to one.
+void check_fields_for_writing(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options);
 
 /// Formats text into a buffer and hands it to a stream in large chunks.
 class TextOut {

@@ -1,6 +1,8 @@
 #include "isohex/io/mesh_io.hpp"
 
 #include "isohex/error.hpp"
+#include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 #include <fmt/format.h>
 
@@ -60,6 +62,10 @@ void write_mesh(const std::filesystem::path& file, const HexMesh& mesh, const Wr
     case Format::unknown: break;
   }
   unknown_format(file);
+}
+
+std::vector<DataField> quality_fields(const HexMesh& mesh) {
+  return {{"scaled_jacobian", scaled_jacobians(mesh)}, {"jacobian_ratio", mesh_jacobians(mesh).ratio}};
 }
 
 }  // namespace isohex::io

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace isohex::io {
 
@@ -36,12 +37,30 @@ struct ReadReport {
   std::size_t skipped_cells = 0;    ///< non-hex cells dropped under skip_non_hex
 };
 
+/// An array of values written beside the mesh, one per hex (a cell field) or per vertex (a
+/// point field): the quality of each hex, which vertices lie on the isosurface. The readers
+/// skip them (the mesh is what they read).
+struct DataField {
+  std::string name;            ///< letters, digits and '_', starting with a letter
+  std::vector<double> values;  ///< one per hex, or one per vertex
+};
+
 /// Options shared by all writers (each writer uses those that apply to it).
 struct WriteOptions {
   bool binary = true;     ///< .vtk/.vtu: binary (exact) rather than ASCII (17 significant digits)
   bool compress = true;   ///< .vtu: zlib-compress the appended data, as VTK does by default
   bool msh_binary = false; ///< .msh: Gmsh's binary variant rather than ASCII (17 significant digits)
+  /// .vtu / .vtk: CellData arrays after the block ids (Float64, one value per hex).
+  std::vector<DataField> cell_fields;
+  /// .vtu / .vtk: PointData arrays after the fixed flags (Float64, one value per vertex).
+  std::vector<DataField> point_fields;
 };
+
+/// The quality of each hex as cell fields for WriteOptions::cell_fields: "scaled_jacobian"
+/// (Verdict's: the corners and the centre) and "jacobian_ratio" (Gmsh's min det J / max det J
+/// over the whole hex, certified: jacobian_ratio() of quality/jacobian_bounds.hpp; <= 0 where
+/// the hex is not valid inside).
+std::vector<DataField> quality_fields(const HexMesh& mesh);
 
 /// Reads a mesh, choosing the reader by extension (case-insensitive).
 HexMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {},

@@ -21,7 +21,7 @@ void write_header(std::ostream& out, bool binary) {
       << (binary ? "BINARY" : "ASCII") << "\nDATASET UNSTRUCTURED_GRID\n";
 }
 
-void write_binary(std::ostream& out, const HexMesh& mesh) {
+void write_binary(std::ostream& out, const HexMesh& mesh, const WriteOptions& options) {
   write_header(out, true);
   BigEndianOut be(out);
   // Each array: its header line, the raw values, and the newline VTK's writer puts after them.
@@ -47,18 +47,31 @@ void write_binary(std::ostream& out, const HexMesh& mesh) {
   section(fmt::format("CELL_TYPES {}\n", mesh.hexes.size()), [&] {
     for (std::size_t i = 0; i < mesh.hexes.size(); ++i) be.put(std::int32_t{vtk::kHexahedron});
   });
+  // CELL_DATA then POINT_DATA, each header once, then its arrays; the fields as one FIELD, which
+  // VTK's reader reads whole (of several SCALARS it reads the first unless told otherwise).
+  const auto fields = [&](const std::vector<DataField>& list) {
+    if (list.empty()) return;
+    out << fmt::format("FIELD FieldData {}\n", list.size());
+    for (const DataField& d : list)
+      section(fmt::format("{} 1 {} double\n", d.name, d.values.size()), [&] {
+        for (const double v : d.values) be.put(v);
+      });
+  };
+  if (mesh.has_blocks() || !options.cell_fields.empty()) out << fmt::format("CELL_DATA {}\n", mesh.hexes.size());
   if (mesh.has_blocks())
-    section(fmt::format("CELL_DATA {}\nSCALARS block int 1\nLOOKUP_TABLE default\n", mesh.hexes.size()), [&] {
+    section("SCALARS block int 1\nLOOKUP_TABLE default\n", [&] {
       for (const Index b : mesh.blocks) be.put(static_cast<std::int32_t>(b));
     });
+  fields(options.cell_fields);
+  if (mesh.has_fixed() || !options.point_fields.empty()) out << fmt::format("POINT_DATA {}\n", mesh.points.size());
   if (mesh.has_fixed())
-    section(fmt::format("POINT_DATA {}\nSCALARS fixed unsigned_char 1\nLOOKUP_TABLE default\n", mesh.points.size()),
-            [&] {
-              for (const std::uint8_t f : mesh.fixed) be.put(static_cast<std::uint8_t>(f ? 1 : 0));
-            });
+    section("SCALARS fixed unsigned_char 1\nLOOKUP_TABLE default\n", [&] {
+      for (const std::uint8_t f : mesh.fixed) be.put(static_cast<std::uint8_t>(f ? 1 : 0));
+    });
+  fields(options.point_fields);
 }
 
-void write_ascii(std::ostream& out, const HexMesh& mesh) {
+void write_ascii(std::ostream& out, const HexMesh& mesh, const WriteOptions& options) {
   write_header(out, false);
   TextOut text(out);
   text.print("POINTS {} double\n", mesh.points.size());
@@ -68,14 +81,25 @@ void write_ascii(std::ostream& out, const HexMesh& mesh) {
     text.print("8 {} {} {} {} {} {} {} {}\n", h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7]);
   text.print("CELL_TYPES {}\n", mesh.hexes.size());
   for (std::size_t i = 0; i < mesh.hexes.size(); ++i) text.print("{}\n", vtk::kHexahedron);
+  const auto fields = [&](const std::vector<DataField>& list) {
+    if (!list.empty()) text.print("FIELD FieldData {}\n", list.size());
+    for (const DataField& d : list) {
+      text.print("{} 1 {} double\n", d.name, d.values.size());
+      for (const double v : d.values) text.print("{:.17g}\n", v);
+    }
+  };
+  if (mesh.has_blocks() || !options.cell_fields.empty()) text.print("CELL_DATA {}\n", mesh.hexes.size());
   if (mesh.has_blocks()) {
-    text.print("CELL_DATA {}\nSCALARS block int 1\nLOOKUP_TABLE default\n", mesh.hexes.size());
+    text.print("SCALARS block int 1\nLOOKUP_TABLE default\n");
     for (const Index b : mesh.blocks) text.print("{}\n", b);
   }
+  fields(options.cell_fields);
+  if (mesh.has_fixed() || !options.point_fields.empty()) text.print("POINT_DATA {}\n", mesh.points.size());
   if (mesh.has_fixed()) {
-    text.print("POINT_DATA {}\nSCALARS fixed unsigned_char 1\nLOOKUP_TABLE default\n", mesh.points.size());
+    text.print("SCALARS fixed unsigned_char 1\nLOOKUP_TABLE default\n");
     for (const std::uint8_t f : mesh.fixed) text.print("{}\n", f ? 1 : 0);
   }
+  fields(options.point_fields);
   text.flush();
 }
 
@@ -83,11 +107,12 @@ void write_ascii(std::ostream& out, const HexMesh& mesh) {
 
 void write_vtk_legacy(const std::filesystem::path& file, const HexMesh& mesh, const WriteOptions& options) {
   check_mesh_for_writing(file, mesh);
+  check_fields_for_writing(file, mesh, options);
   write_atomically(file, [&](std::ostream& out) {
     if (options.binary)
-      write_binary(out, mesh);
+      write_binary(out, mesh, options);
     else
-      write_ascii(out, mesh);
+      write_ascii(out, mesh, options);
   });
 }
 

@@ -5,6 +5,7 @@
 
 #include "isohex/error.hpp"
 #include "isohex/io/atomic_file.hpp"
+#include "isohex/io/format_support.hpp"
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
@@ -57,7 +58,7 @@ void store(unsigned char* out, std::size_t i, T v) {
 
 /// The mesh's arrays, in the order VTK writes them. Their generators check the data, so an
 /// invalid mesh fails in mid-write (and write_atomically discards the partial file).
-std::vector<Column> columns(const fs::path& file, const HexMesh& mesh) {
+std::vector<Column> columns(const fs::path& file, const HexMesh& mesh, const WriteOptions& options) {
   const std::size_t np = mesh.points.size(), nh = mesh.hexes.size();
   if (mesh.has_blocks() && mesh.blocks.size() != nh)
     throw Error(fmt::format("{}: cannot write: {} block ids for {} hexes", file.string(), mesh.blocks.size(), nh));
@@ -70,12 +71,22 @@ std::vector<Column> columns(const fs::path& file, const HexMesh& mesh) {
                       for (std::size_t i = 0; i < n; ++i) out[i] = mesh.fixed[f + i] ? 1 : 0;
                     },
                     20});
+  // The fields (checked before the write began) as Float64 arrays.
+  const auto field = [](const char* section, const DataField& d) {
+    return Column{section, d.name.c_str(), "Float64", 8, 1, d.values.size(),
+                  [&d](std::size_t f, std::size_t n, unsigned char* out) {
+                    std::memcpy(out, d.values.data() + f, n * sizeof(double));
+                  },
+                  6};
+  };
+  for (const DataField& d : options.point_fields) cols.push_back(field("PointData", d));
   if (mesh.has_blocks())
     cols.push_back({"CellData", "block", "Int32", 4, 1, nh,
                     [&mesh](std::size_t f, std::size_t n, unsigned char* out) {
                       std::memcpy(out, mesh.blocks.data() + f, n * sizeof(Index));
                     },
                     10});
+  for (const DataField& d : options.cell_fields) cols.push_back(field("CellData", d));
   cols.push_back({"Points", "Points", "Float64", 8, 3, 3 * np,
                   [&mesh, &file](std::size_t f, std::size_t n, unsigned char* out) {
                     for (std::size_t i = 0; i < n; ++i) {
@@ -261,8 +272,9 @@ void write_ascii(std::ostream& os, const HexMesh& mesh, const std::vector<Column
 }  // namespace
 
 void write_vtu(const fs::path& file, const HexMesh& mesh, const WriteOptions& options) {
+  check_fields_for_writing(file, mesh, options);
   write_atomically(file, [&](std::ostream& os) {
-    const std::vector<Column> cols = columns(file, mesh);
+    const std::vector<Column> cols = columns(file, mesh, options);
     if (options.binary)
       write_appended(os, file, mesh, cols, options.compress);
     else
