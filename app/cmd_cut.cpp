@@ -149,7 +149,7 @@ void register_cut(CLI::App& app) {
       "  isohex generate box -o box.vtu -n 16 --size 40\n"
       "  isohex cut box.vtu -o lobes.vtu --volume hydrogen.vti --iso 0.1 --keep inside   # along an isosurface");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp .msh .exo)")->required();
-  cmd->add_option("-o,--output", a->output, "The cut mesh (a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio)")->required();
+  cmd->add_option("-o,--output", a->output, "The cut mesh (a .vtu / .vtk / .exo carries per hex scaled_jacobian and jacobian_ratio)")->required();
   cmd->add_option("--surface", a->surfaces,
                   "A cut surface as a shape expression (see 'isohex volume shape --help'); its inside is the shape's. "
                   "Repeat for successive cuts");

@@ -598,7 +598,7 @@ void register_mesh(CLI::App& app) {
   cmd->add_option("--keep", a->keep, "With --cut / --cut-iso: both (default: the inside a new block), inside or outside")
       ->check(CLI::IsMember({"both", "inside", "outside"}));
   cmd->add_option("-o,--output", a->output,
-                  fmt::format("Output mesh ({}); a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio, per "
+                  fmt::format("Output mesh ({}); a .vtu / .vtk / .exo carries per hex scaled_jacobian and jacobian_ratio, per "
                               "vertex surface (index, -1 inside, -2 domain box) and released (0/1)",
                               io::kMeshExtensions))
       ->required();

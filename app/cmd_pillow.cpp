@@ -89,7 +89,7 @@ void register_pillow(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("pillow", "Insert a dual sheet around a shrink set by pillowing");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp)")->required();
-  cmd->add_option("-o,--output", a->output, "Pillowed mesh (a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio)")->required();
+  cmd->add_option("-o,--output", a->output, "Pillowed mesh (a .vtu / .vtk / .exo carries per hex scaled_jacobian and jacobian_ratio)")->required();
   cmd->add_option("--shrink-set", a->shrink_set,
                   "boundary (default: a sheet along every boundary component), block:ID, region:EXPR (hexes whose "
                   "centroid is inside the shape) or ids:FILE (one hex id per line)");

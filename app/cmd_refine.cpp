@@ -82,7 +82,7 @@ void register_refine(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("refine", "Refine hexes locally, conformingly, by 3-refinement templates");
   cmd->add_option("input", a->input, "Hex mesh (.vtk .vtu .mesh .inp .exo .msh)")->required();
-  cmd->add_option("-o,--output", a->output, "Refined mesh (a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio)")->required();
+  cmd->add_option("-o,--output", a->output, "Refined mesh (a .vtu / .vtk / .exo carries per hex scaled_jacobian and jacobian_ratio)")->required();
   cmd->add_option("--hexes", a->hexes,
                   "Hexes to refine: all (default), block:ID, region:EXPR (hexes whose centroid is inside the shape, "
                   "syntax of 'isohex volume shape') or ids:FILE (one hex id per line); their 8 vertices are marked");

@@ -197,7 +197,7 @@ void register_smooth(CLI::App& app) {
       "  isohex smooth good.vtu -o better.vtu --shape-guard 0.3   # none falls below 0.3 by rank, none below it falls\n"
       "  isohex smooth stuck.vtu -o out.vtu --search-trials 1000000   # a longer random walk where hexes stay below 0.2");
   cmd->add_option("mesh", a->in, "Input hex mesh (.vtk .vtu .mesh .inp)")->required();
-  cmd->add_option("-o,--output", a->out, "Output mesh (a .vtu / .vtk carries per hex scaled_jacobian and jacobian_ratio)")->required();
+  cmd->add_option("-o,--output", a->out, "Output mesh (a .vtu / .vtk / .exo carries per hex scaled_jacobian and jacobian_ratio)")->required();
   cmd->add_flag("--untangle", a->untangle, "First make every hex valid (scaled Jacobian >= --margin where possible)");
   const std::map<std::string, FixedVertices> fixed_names{
       {"boundary", FixedVertices::boundary}, {"file", FixedVertices::file}, {"none", FixedVertices::none}};

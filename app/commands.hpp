@@ -53,7 +53,7 @@ struct VolumeReadArgs {
 /// Reads a mesh for a command; prints how many non-hex cells were dropped, if any.
 HexMesh load_mesh(const std::string& file, bool skip_non_hex);
 
-/// Writes a mesh a command made: a .vtu or .vtk carries each hex's quality
+/// Writes a mesh a command made: a .vtu, .vtk or Exodus file carries each hex's quality
 /// (io::quality_fields: "scaled_jacobian", "jacobian_ratio") and `point_fields`, so that a
 /// viewer colours the worst hexes without recomputing them.
 void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::DataField> point_fields = {});

@@ -29,7 +29,8 @@ void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::
   std::string ext = std::filesystem::path(file).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   io::WriteOptions options;
-  if (ext == ".vtu" || ext == ".vtk") {  // the other formats have no place for them
+  // (Exodus: element and nodal variables at one time step; the other formats have no place.)
+  if (ext == ".vtu" || ext == ".vtk" || ext == ".exo" || ext == ".e" || ext == ".ex2") {
     options.cell_fields = io::quality_fields(mesh);
     options.point_fields = std::move(point_fields);
   }

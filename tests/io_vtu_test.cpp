@@ -528,7 +528,7 @@ TEST(VtuWrite, FailedWriteLeavesNoFile) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 }
 
-// Fields written beside the mesh (.vtu and .vtk, binary and ASCII): the readers skip them and
+// Fields written beside the mesh (.vtu and .vtk, binary and ASCII; Exodus variables): the readers skip them and
 // read the same mesh; a field that does not fit the mesh is refused before anything is written.
 TEST(MeshFields, WrittenBesideTheMeshAndSkippedByTheReaders) {
   const fs::path dir = scratch_dir();
@@ -543,7 +543,7 @@ TEST(MeshFields, WrittenBesideTheMeshAndSkippedByTheReaders) {
   o.point_fields = {{"height", {}}};
   for (const Vec3& p : m.points) o.point_fields[0].values.push_back(p.z());
   for (const bool binary : {true, false})
-    for (const char* ext : {".vtu", ".vtk"}) {
+    for (const char* ext : {".vtu", ".vtk", ".exo"}) {
       SCOPED_TRACE(std::string(ext) + (binary ? " binary" : " ascii"));
       o.binary = binary;
       const fs::path f = dir / (std::string("fields") + (binary ? "_b" : "_a") + ext);

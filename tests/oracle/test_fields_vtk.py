@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Oracle test: the arrays isohex writes beside its meshes, read by VTK.
 
-`isohex mesh` (.vtu and .vtk), `isohex cut` and `isohex convert --quality-fields` (ASCII .vtk and
-.vtu) write each hex's `scaled_jacobian` and `jacobian_ratio` as cell arrays, and `isohex mesh`
+`isohex mesh` (.vtu, .vtk and Exodus, there as element and nodal variables), `isohex cut` and
+`isohex convert --quality-fields` (ASCII .vtk and .vtu) write each hex's `scaled_jacobian` and `jacobian_ratio` as cell arrays, and `isohex mesh`
 each vertex's `surface` and `released` as point arrays. VTK's readers must find them; the
 scaled Jacobian must equal vtkMeshQuality's (Verdict) to 1e-12; the jacobian ratio must lie in
 (0, 1] for these valid meshes; the vertices marked on the surface must lie on the sphere and
@@ -51,6 +51,33 @@ def check_quality(path, g):
     check(err <= 1e-12, f"{path}: scaled_jacobian differs from VTK's by {err}")
     check(ratio.min() > 0 and ratio.max() <= 1 + 1e-12, f"{path}: jacobian_ratio in [{ratio.min()}, {ratio.max()}]")
     print(f"{path}: {len(sj)} hexes, scaled Jacobian within {err:.1e} of VTK's, jacobian ratio {ratio.min():.3f}..{ratio.max():.3f}")
+
+
+def check_exodus(path):
+    """vtkExodusIIReader: the element variables per block beside VTK's own scaled Jacobian (the
+    reader hands the points over as floats: 1e-5), the nodal variables."""
+    r = vtk.vtkExodusIIReader()
+    r.SetFileName(path)
+    r.UpdateInformation()
+    r.SetAllArrayStatus(vtk.vtkExodusIIReader.ELEM_BLOCK, 1)
+    r.SetAllArrayStatus(vtk.vtkExodusIIReader.NODAL, 1)
+    r.Update()
+    it = r.GetOutput().NewIterator()
+    it.InitTraversal()
+    blocks = 0
+    while not it.IsDoneWithTraversal():
+        g = it.GetCurrentDataObject()
+        sj = array(g.GetCellData(), "scaled_jacobian")
+        ratio = array(g.GetCellData(), "jacobian_ratio")
+        check(sj is not None and ratio is not None, f"{path}: block {blocks + 1} has no element variables")
+        check(array(g.GetPointData(), "surface") is not None, f"{path}: block {blocks + 1} has no nodal variable surface")
+        if sj is not None:
+            err = np.abs(sj - hex_quality(g)).max()
+            check(err <= 1e-5, f"{path}: block {blocks + 1}: scaled_jacobian differs from VTK's by {err}")
+        blocks += 1
+        it.GoToNextItem()
+    check(blocks == 2, f"{path}: {blocks} element blocks, expected the cut's 2")
+    print(f"{path}: {blocks} blocks with their element and nodal variables")
 
 
 def check_places(path, g):
@@ -105,6 +132,9 @@ def main():
         g = read(t(f"ball.{ext}"))
         check_quality(t(f"ball.{ext}"), g)
         check_places(t(f"ball.{ext}"), g)
+    run(a.cli, "mesh", "--shape", "sphere(0,0,0,1)", "--resolution", "14", "--cut", "plane(0.1,0,0, 1,0.2,0)",
+        "-o", t("ball.exo"))
+    check_exodus(t("ball.exo"))
     run(a.cli, "cut", t("ball.vtu"), "-o", t("cut.vtu"), "--surface", "plane(0.1,0,0, 1,0.2,0)")
     check_quality(t("cut.vtu"), read(t("cut.vtu")))
     run(a.cli, "convert", t("cut.vtu"), t("cut_ascii.vtk"), "--ascii", "--quality-fields")

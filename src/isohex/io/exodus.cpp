@@ -48,7 +48,8 @@ std::mutex& exodus_mutex() {
   X(ex_put_coord_names) X(ex_put_elem_block) X(ex_put_elem_conn) X(ex_put_names) X(ex_put_id_map)                 \
   X(ex_put_side_set_param) X(ex_put_side_set) X(ex_put_node_set_param) X(ex_put_node_set) X(ex_get_names)        \
   X(ex_get_init) X(ex_get_coord) X(ex_get_id_map) X(ex_get_ids) X(ex_get_elem_block) X(ex_get_elem_conn)         \
-  X(ex_get_node_set_param) X(ex_get_node_set)
+  X(ex_get_node_set_param) X(ex_get_node_set) X(ex_put_variable_param) X(ex_put_variable_names) X(ex_put_time)   \
+  X(ex_put_var)
 
 struct ExodusApi {
 #define ISOHEX_EXODUS_MEMBER(f) decltype(&::f) f = nullptr;
@@ -136,7 +137,44 @@ class NameList {
   std::vector<char*> ptrs_;
 };
 
-void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh& mesh) {
+// WriteOptions' fields as results at one time step (time 0): nodal variables in node order,
+// element variables block by block in the file's element order (`order`: file position -> hex).
+void put_fields(int id, const fs::path& file, const WriteOptions& options, const BlockTable& blocks,
+                const std::vector<Index>& order) {
+  if (options.cell_fields.empty() && options.point_fields.empty()) return;
+  const auto declare = [&](ex_entity_type type, const std::vector<DataField>& fields) {
+    if (fields.empty()) return;
+    std::vector<std::string> names;
+    for (const DataField& f : fields) names.push_back(f.name);
+    NameList list(names);
+    const int n = static_cast<int>(fields.size());
+    check(api().ex_put_variable_param(id, type, n), file, "declaring the variables");
+    check(api().ex_put_variable_names(id, type, n, list.get()), file, "writing the variable names");
+  };
+  declare(EX_NODAL, options.point_fields);
+  declare(EX_ELEM_BLOCK, options.cell_fields);
+  const double time = 0;
+  check(api().ex_put_time(id, 1, &time), file, "writing the time step");
+  for (std::size_t k = 0; k < options.point_fields.size(); ++k) {
+    const DataField& f = options.point_fields[k];
+    check(api().ex_put_var(id, 1, EX_NODAL, static_cast<int>(k) + 1, 1, static_cast<int64_t>(f.values.size()),
+                           f.values.data()),
+          file, fmt::format("writing the nodal variable {}", f.name));
+  }
+  for (std::size_t k = 0; k < options.cell_fields.size(); ++k) {
+    const DataField& f = options.cell_fields[k];
+    std::size_t at = 0;
+    for (std::size_t b = 0; b < blocks.values.size(); ++b) {
+      std::vector<double> values;
+      for (; at < order.size() && blocks.of_hex[order[at]] == static_cast<Index>(b); ++at) values.push_back(f.values[order[at]]);
+      check(api().ex_put_var(id, 1, EX_ELEM_BLOCK, static_cast<int>(k) + 1, blocks.file_ids[b],
+                             static_cast<int64_t>(values.size()), values.data()),
+            file, fmt::format("writing the element variable {}", f.name));
+    }
+  }
+}
+
+void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh& mesh, const WriteOptions& options) {
   int comp_ws = 8, io_ws = 8;  // doubles in memory and in the file
   // Classic netCDF (64-bit offsets), not netCDF-4/HDF5: its bytes depend only on the data,
   // so the output is deterministic, and every Exodus reader handles it.
@@ -225,6 +263,8 @@ void write_exodus_file(const fs::path& tmp, const fs::path& file, const HexMesh&
     NameList sset_names(sset);
     check(api().ex_put_names(id, EX_SIDE_SET, sset_names.get()), file, "writing the side set names");
   }
+
+  put_fields(id, file, options, blocks, order);
 
   std::vector<std::string> nset;
   ex_entity_id next_set = 1;
@@ -385,8 +425,9 @@ HexMesh read_exodus(const fs::path& file, const ReadOptions& options, ReadReport
   return read_exodus_file(file, options, report ? *report : local);
 }
 
-void write_exodus(const fs::path& file, const HexMesh& mesh, const WriteOptions&) {
+void write_exodus(const fs::path& file, const HexMesh& mesh, const WriteOptions& options) {
   check_mesh_for_writing(file, mesh);
+  check_fields_for_writing(file, mesh, options);
   static std::atomic<unsigned> counter{0};
   fs::path dir = file.parent_path();
   if (dir.empty()) dir = ".";
@@ -400,7 +441,7 @@ void write_exodus(const fs::path& file, const HexMesh& mesh, const WriteOptions&
       const std::lock_guard lock(exodus_mutex());
       load_exodus(file);
       api().ex_opts(EX_DEFAULT);
-      write_exodus_file(tmp, file, mesh);
+      write_exodus_file(tmp, file, mesh, options);
     }
     std::error_code ec;
     fs::rename(tmp, file, ec);

@@ -50,9 +50,11 @@ struct WriteOptions {
   bool binary = true;     ///< .vtk/.vtu: binary (exact) rather than ASCII (17 significant digits)
   bool compress = true;   ///< .vtu: zlib-compress the appended data, as VTK does by default
   bool msh_binary = false; ///< .msh: Gmsh's binary variant rather than ASCII (17 significant digits)
-  /// .vtu / .vtk: CellData arrays after the block ids (Float64, one value per hex).
+  /// .vtu / .vtk: CellData arrays after the block ids (Float64, one value per hex); Exodus:
+  /// element variables at one time step (0).
   std::vector<DataField> cell_fields;
-  /// .vtu / .vtk: PointData arrays after the fixed flags (Float64, one value per vertex).
+  /// .vtu / .vtk: PointData arrays after the fixed flags (Float64, one value per vertex); Exodus:
+  /// nodal variables.
   std::vector<DataField> point_fields;
 };
 
