@@ -78,11 +78,11 @@ void run(const Args& a) {
       fmt::print("{} hexes below 0.2 (min SJ {:.4f}); the cut again with a tie band of {}\n", first.below, first.min_sj,
                  kRetryTieBand);
       opt.tie_band = kRetryTieBand;
-      attempts = {{"first", {{"below_0.2", first.below}, {"min_sj", first.min_sj}}}, {"kept", "first"}};
+      attempts = {{"first", attempt_json(first)}, {"kept", "first"}};
       try {
         CutResult again = cut(mesh, surfaces, opt);
         const RoundScore second = mesh_score(again.mesh);
-        attempts["tie_band"] = {{"tie_band", kRetryTieBand}, {"below_0.2", second.below}, {"min_sj", second.min_sj}};
+        attempts["tie_band"] = attempt_json(second, kRetryTieBand);
         if (first.worse_than(second)) r = std::move(again), attempts["kept"] = "tie_band";
       } catch (const Error& e) {
         attempts["tie_band"] = {{"tie_band", kRetryTieBand}, {"error", e.what()}};
@@ -113,8 +113,10 @@ void run(const Args& a) {
     steps.back()["surface_quads"] = r.surface_quads[i].size();
   }
   report["cuts"] = steps;
-  const MetricSummary q = summarize(HexMetric::scaled_jacobian, scaled_jacobians(r.mesh), 5);
-  const ValiditySummary validity = summarize_validity(r.mesh);
+  std::vector<double> sj = scaled_jacobians(r.mesh);
+  MeshJacobians jacobians = mesh_jacobians(r.mesh);
+  const MetricSummary q = summarize(HexMetric::scaled_jacobian, sj, 5);
+  const ValiditySummary validity = summarize_validity(jacobians);
   fmt::print("result: {} hexes, {} vertices\n", r.mesh.num_hexes(), r.mesh.num_vertices());
   fmt::print("scaled Jacobian: min {:.4f}  mean {:.4f}  inverted (< 0): {}  below {}: {}\n", q.min, q.mean, q.inverted,
              kQuestionableSJ, q.inverted + q.questionable + q.degenerate);
@@ -128,7 +130,7 @@ void run(const Args& a) {
   report["hexes"] = r.mesh.num_hexes();
   report["vertices"] = r.mesh.num_vertices();
   report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  write_result(a.output, r.mesh);
+  write_result(a.output, r.mesh, io::quality_fields(std::move(sj), std::move(jacobians.ratio)));
   fmt::print("wrote {}\n", a.output);
   if (!a.json.empty()) write_json(a.json, report);
   if (q.inverted + q.degenerate > 0) exit_code() = 1;

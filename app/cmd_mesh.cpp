@@ -315,8 +315,8 @@ void run(const Args& a) {
       const bool better = first.worse_than(second);
       fmt::print("cut: {} below 0.2 with the tie band (min SJ {:.4f}); the {} kept\n", second.below, second.min_sj,
                  better ? "second" : "first");
-      nlohmann::json attempts = {{"first", {{"below_0.2", first.below}, {"min_sj", first.min_sj}}},
-                                 {"tie_band", {{"tie_band", kRetryTieBand}, {"below_0.2", second.below}, {"min_sj", second.min_sj}}},
+      nlohmann::json attempts = {{"first", attempt_json(first)},
+                                 {"tie_band", attempt_json(second, kRetryTieBand)},
                                  {"kept", better ? "tie_band" : "first"}};
       if (!better) exchange(kept);
       cutting["attempts"] = std::move(attempts);
@@ -330,7 +330,8 @@ void run(const Args& a) {
   const contour::SurfaceDistance dist = contour::surface_distance(region, out.mesh, out.vertex_place, &released);
   const std::vector<double> sj = scaled_jacobians(out.mesh);
   const MetricSummary summary = summarize(HexMetric::scaled_jacobian, sj);
-  const ValiditySummary validity = summarize_validity(out.mesh);
+  MeshJacobians jacobians = mesh_jacobians(out.mesh);
+  const ValiditySummary validity = summarize_validity(jacobians);
   // Vertices outside the sampled domain (a placement across it; 1e-9 of its diagonal spare).
   std::size_t outside_domain = 0;
   {
@@ -342,12 +343,12 @@ void run(const Args& a) {
   {
     // Per vertex, where the pipeline left it: "surface" the index of the region surface it lies
     // on (-1 inside, -2 on the domain box), "released" 1 if it was released into the band.
-    io::DataField surface{"surface", std::vector<double>(out.mesh.points.size(), contour::kInteriorVertex)};
-    io::DataField loose{"released", std::vector<double>(out.mesh.points.size(), 0.0)};
-    for (std::size_t v = 0; v < out.vertex_place.size() && v < surface.values.size(); ++v)
-      surface.values[v] = out.vertex_place[v];
-    for (std::size_t v = 0; v < released.size() && v < loose.values.size(); ++v) loose.values[v] = released[v];
-    write_result(a.output, out.mesh, {std::move(surface), std::move(loose)});
+    // (`released` is empty where the optimisation did not run.)
+    io::DataField surface{"surface", std::vector<double>(out.vertex_place.begin(), out.vertex_place.end())};
+    io::DataField loose{"released", released.empty() ? std::vector<double>(out.mesh.points.size(), 0.0)
+                                                     : std::vector<double>(released.begin(), released.end())};
+    write_result(a.output, out.mesh, io::quality_fields(sj, std::move(jacobians.ratio)),
+                 {std::move(surface), std::move(loose)});
   }
   const double write_time = seconds_since(t);
 

@@ -54,9 +54,13 @@ struct VolumeReadArgs {
 HexMesh load_mesh(const std::string& file, bool skip_non_hex);
 
 /// Writes a mesh a command made: a .vtu, .vtk or Exodus file carries each hex's quality
-/// (io::quality_fields: "scaled_jacobian", "jacobian_ratio") and `point_fields`, so that a
-/// viewer colours the worst hexes without recomputing them.
-void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::DataField> point_fields = {});
+/// (io::quality_fields: "scaled_jacobian", "jacobian_ratio"), so that a viewer colours the worst
+/// hexes without recomputing them.
+void write_result(const std::string& file, const HexMesh& mesh);
+/// The same with the quality a command has already computed (`cell_fields`) and `point_fields`;
+/// the other formats have no place for them.
+void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::DataField> cell_fields,
+                  std::vector<io::DataField> point_fields = {});
 
 /// Min, mean, inverted, below 0.2 and degenerate of a scaled-Jacobian summary (the reports of
 /// `isohex smooth` and `isohex cut`).

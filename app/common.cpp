@@ -25,16 +25,29 @@ HexMesh load_mesh(const std::string& file, bool skip_non_hex) {
   return mesh;
 }
 
-void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::DataField> point_fields) {
+namespace {
+
+// .vtu and .vtk (arrays) and Exodus (element and nodal variables at one time step).
+bool carries_fields(const std::string& file) {
   std::string ext = std::filesystem::path(file).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".vtu" || ext == ".vtk" || ext == ".exo" || ext == ".e" || ext == ".ex2";
+}
+
+}  // namespace
+
+void write_result(const std::string& file, const HexMesh& mesh, std::vector<io::DataField> cell_fields,
+                  std::vector<io::DataField> point_fields) {
   io::WriteOptions options;
-  // (Exodus: element and nodal variables at one time step; the other formats have no place.)
-  if (ext == ".vtu" || ext == ".vtk" || ext == ".exo" || ext == ".e" || ext == ".ex2") {
-    options.cell_fields = io::quality_fields(mesh);
+  if (carries_fields(file)) {
+    options.cell_fields = std::move(cell_fields);
     options.point_fields = std::move(point_fields);
   }
   io::write_mesh(file, mesh, options);
+}
+
+void write_result(const std::string& file, const HexMesh& mesh) {
+  write_result(file, mesh, carries_fields(file) ? io::quality_fields(mesh) : std::vector<io::DataField>{});
 }
 
 nlohmann::json quality_json(const MetricSummary& s) {

@@ -39,14 +39,16 @@ nlohmann::json mesh_shape_by_cuts(const std::string& expression, double cell_siz
   fmt::print("dropped {} hexes outside the shape\n", r.dropped_hexes);
   rows.push_back(stage_row("cuts", r.mesh, seconds, keep_values));
   const ValidationReport check = validate(r.mesh);
-  const MetricSummary q = summarize(HexMetric::scaled_jacobian, scaled_jacobians(r.mesh));
-  const ValiditySummary validity = summarize_validity(r.mesh);
+  std::vector<double> sj = scaled_jacobians(r.mesh);
+  MeshJacobians jacobians = mesh_jacobians(r.mesh);
+  const MetricSummary q = summarize(HexMetric::scaled_jacobian, sj);
+  const ValiditySummary validity = summarize_validity(jacobians);
   fmt::print("mesh: {} hexes, {} vertices, {} boundary quads, {}\n", r.mesh.num_hexes(), r.mesh.num_vertices(),
              check.num_boundary_quads, check.valid() ? "valid" : "NOT VALID");
   fmt::print("  scaled Jacobian: min {:.4f}  mean {:.4f}\n  inverted (< 0): {}   questionable (< 0.2): {}   degenerate: {}\n",
              q.min, q.mean, q.inverted, q.questionable, q.degenerate);
   fmt::print("  {}\n", describe(validity));
-  write_result(output, r.mesh);
+  write_result(output, r.mesh, io::quality_fields(std::move(sj), std::move(jacobians.ratio)));
   inverted_left = q.inverted + q.degenerate;
   return {{"features", "sheets"},
           {"pieces", pieces},

@@ -342,6 +342,12 @@ RoundScore mesh_score(const HexMesh& mesh) {
   return s;
 }
 
+nlohmann::json attempt_json(const RoundScore& score, double tie_band) {
+  nlohmann::json j = {{"below_0.2", score.below}, {"min_sj", score.min_sj}};
+  if (tie_band > 0) j["tie_band"] = tie_band;
+  return j;
+}
+
 nlohmann::json release_rounds(HexMesh& mesh, BoundarySurface& surface, double& band, const OptimizeOptions& o,
                               std::size_t* reattached, bool* poor_left, bool widen_if_poor) {
   const Incidence inc = vertex_hexes(mesh);

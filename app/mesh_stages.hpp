@@ -67,6 +67,9 @@ struct RoundScore {
 };
 /// The score of the whole mesh (the release rounds' and the cut attempts' judge).
 RoundScore mesh_score(const HexMesh& mesh);
+/// How a cut attempt ended, for the JSON reports of `isohex mesh --cut` and `isohex cut`:
+/// {"below_0.2", "min_sj"}, with "tie_band" when `tie_band` > 0.
+nlohmann::json attempt_json(const RoundScore& score, double tie_band = 0);
 
 /// After a first run_optimisation() with `surface`: up to five rounds that release the
 /// boundary vertices of the hexes still below 0.2 (or with a jacobian ratio below 0.1), and of

@@ -75,6 +75,16 @@ std::map<std::pair<Index, Index>, std::vector<Vec3>> boundary_edge_normals(const
   return out;
 }
 
+// `isohex cut DIR/IN -o DIR/OUT ARGS --json ...`, expected to exit 0 (its output in `log`):
+// the JSON report.
+nlohmann::json cut_report(const std::filesystem::path& dir, const std::string& in, const std::string& out,
+                          const std::string& args, std::string& log) {
+  const auto json = dir / (out + ".json");
+  EXPECT_EQ(run_cli("cut " + quote(dir / in) + " -o " + quote(dir / out) + " " + args + " --json " + quote(json), &log), 0)
+      << log;
+  return nlohmann::json::parse(io::read_file(json));
+}
+
 }  // namespace
 
 // The paper's figures 6 and 7: a cube carved by three spheres that overlap each other and cross
@@ -379,12 +389,7 @@ TEST(Cut, CommandLine) {
   const auto dir = scratch_dir();
   ASSERT_EQ(run_cli("generate box -n 8 --size 2 -o " + quote(dir / "cube8.vtu")), 0);
   std::string out;
-  ASSERT_EQ(run_cli("cut " + quote(dir / "cube8.vtu") + " -o " + quote(dir / "carved.vtu") +
-                        " --surface 'sphere(2,2,2,1.1)' --keep outside --json " + quote(dir / "cut.json"),
-                    &out),
-            0)
-      << out;
-  const auto j = nlohmann::json::parse(io::read_file(dir / "cut.json"));
+  const auto j = cut_report(dir, "cube8.vtu", "carved.vtu", "--surface 'sphere(2,2,2,1.1)' --keep outside", out);
   EXPECT_EQ(j["quality"]["below_0.2"].get<int>(), 0);
   EXPECT_EQ(j["validity"]["not_valid_inside"].get<int>(), 0);
   EXPECT_EQ(j["cuts"][0]["sheet_hexes"].get<int>(), j["cuts"][0]["surface_quads"].get<int>());  // one sheet (one side kept)
@@ -421,12 +426,7 @@ TEST(Cut, CommandLineCutsAgainWithATieBand) {
   const auto dir = scratch_dir();
   ASSERT_EQ(run_cli("generate box -n 12 --size 2 -o " + quote(dir / "cube12.vtu")), 0);
   std::string out;
-  ASSERT_EQ(run_cli("cut " + quote(dir / "cube12.vtu") + " -o " + quote(dir / "wedge.vtu") +
-                        " --surface 'plane(0.5,0.5,0.5, 1,0.3,0.2)' --json " + quote(dir / "wedge.json"),
-                    &out),
-            0)
-      << out;
-  const auto j = nlohmann::json::parse(io::read_file(dir / "wedge.json"));
+  const auto j = cut_report(dir, "cube12.vtu", "wedge.vtu", "--surface 'plane(0.5,0.5,0.5, 1,0.3,0.2)'", out);
   ASSERT_TRUE(j.contains("attempts")) << out;
   EXPECT_EQ(j["attempts"]["kept"], "tie_band");
   EXPECT_LT(j["attempts"]["first"]["min_sj"].get<double>(), 0.01);
@@ -436,12 +436,8 @@ TEST(Cut, CommandLineCutsAgainWithATieBand) {
   const double bound = std::abs(a.dot(b.cross(c)));
   EXPECT_NEAR(j["quality"]["min"].get<double>(), bound, 2e-3);
   // Asked for by hand, the tie band runs once.
-  ASSERT_EQ(run_cli("cut " + quote(dir / "cube12.vtu") + " -o " + quote(dir / "wedge2.vtu") +
-                        " --surface 'plane(0.5,0.5,0.5, 1,0.3,0.2)' --tie-band 0.05 --json " + quote(dir / "wedge2.json"),
-                    &out),
-            0)
-      << out;
-  const auto k = nlohmann::json::parse(io::read_file(dir / "wedge2.json"));
+  const auto k =
+      cut_report(dir, "cube12.vtu", "wedge2.vtu", "--surface 'plane(0.5,0.5,0.5, 1,0.3,0.2)' --tie-band 0.05", out);
   EXPECT_FALSE(k.contains("attempts"));
   EXPECT_EQ(k["quality"]["min"], j["quality"]["min"]);
 }

@@ -64,8 +64,12 @@ void write_mesh(const std::filesystem::path& file, const HexMesh& mesh, const Wr
   unknown_format(file);
 }
 
+std::vector<DataField> quality_fields(std::vector<double> scaled_jacobians, std::vector<double> jacobian_ratios) {
+  return {{"scaled_jacobian", std::move(scaled_jacobians)}, {"jacobian_ratio", std::move(jacobian_ratios)}};
+}
+
 std::vector<DataField> quality_fields(const HexMesh& mesh) {
-  return {{"scaled_jacobian", scaled_jacobians(mesh)}, {"jacobian_ratio", mesh_jacobians(mesh).ratio}};
+  return quality_fields(scaled_jacobians(mesh), mesh_jacobians(mesh).ratio);
 }
 
 }  // namespace isohex::io

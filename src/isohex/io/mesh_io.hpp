@@ -63,6 +63,8 @@ struct WriteOptions {
 /// over the whole hex, certified: jacobian_ratio() of quality/jacobian_bounds.hpp; <= 0 where
 /// the hex is not valid inside).
 std::vector<DataField> quality_fields(const HexMesh& mesh);
+/// The same from values already computed: scaled_jacobians() and mesh_jacobians().ratio.
+std::vector<DataField> quality_fields(std::vector<double> scaled_jacobians, std::vector<double> jacobian_ratios);
 
 /// Reads a mesh, choosing the reader by extension (case-insensitive).
 HexMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {},

@@ -147,7 +147,10 @@ nlohmann::json to_json(const MetricSummary& s) {
 }
 
 ValiditySummary summarize_validity(const HexMesh& mesh, std::size_t keep) {
-  const MeshJacobians mj = mesh_jacobians(mesh);
+  return summarize_validity(mesh_jacobians(mesh), keep);
+}
+
+ValiditySummary summarize_validity(const MeshJacobians& mj, std::size_t keep) {
   ValiditySummary s;
   s.hexes = mj.valid.size();
   for (std::size_t h = 0; h < mj.valid.size(); ++h) {

@@ -4,6 +4,7 @@
 /// (inverted < 0, questionable < 0.2, degenerate), a histogram, and the worst elements.
 
 #include "isohex/quality/hex_quality.hpp"
+#include "isohex/quality/jacobian_bounds.hpp"
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -80,6 +81,8 @@ struct ValiditySummary {
 };
 /// Counts mesh_jacobians() of `mesh`, keeping up to `keep` ids of hexes not valid inside.
 ValiditySummary summarize_validity(const HexMesh& mesh, std::size_t keep = 20);
+/// The same from mesh_jacobians() already computed (whose ratios a writer may want too).
+ValiditySummary summarize_validity(const MeshJacobians& jacobians, std::size_t keep = 20);
 /// One line: "validity inside: N not valid inside, G with det J <= 0 at a Gauss point, ...".
 std::string describe(const ValiditySummary& s);
 nlohmann::json to_json(const ValiditySummary& s);

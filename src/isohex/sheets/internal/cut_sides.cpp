@@ -114,10 +114,10 @@ bool keeps_to(const Keeps& v, const Keep& keep, double cos_limit) {
 }
 
 // Whether the edge a-b runs along a curve of two surfaces its ends share (a level set, or a
-// face of the input's triangles facing alike): its midpoint is on both, within a quarter of the edge's length (|L| / |grad L|; a face of the input's triangles
-// counts as on). Not an edge across a patch between two branches of the curve: the bottom of a
-// plate thinner than a cell standing on a face of the box has both ends on the plate's skin and
-// on the box face, its middle inside the plate; no cut point collapses such an edge, and its
+// face of the input's triangles facing alike, which counts as on): its midpoint is on both,
+// within a quarter of the edge's length (|L| / |grad L|). Not an edge across a patch between
+// two branches of the curve: the bottom of a plate thinner than a cell standing on a face of the
+// box has both ends on the plate's skin and on the box face, its middle inside the plate; no cut point collapses such an edge, and its
 // ends, sent to one side, would drag the next such edge with them along the whole plate
 // (cthead h 4, the sagittal plane: 14 hexes flattened to SJ 0).
 bool along_curve(const Vec3& a, const Vec3& b, const Keeps& ka, const Keeps& kb,
@@ -159,12 +159,11 @@ std::size_t doubled_curve_ends(const HexMesh& m, const std::vector<contour::Leve
   };
   std::size_t moved = 0;
   for (const auto& [a, b] : edges) {
-    if (keeps[a].size() < 2 || keeps[b].size() < 2 ||
-        !along_curve(m.points[a], m.points[b], keeps[a], keeps[b], levels, cos_limit))
-      continue;
+    if (keeps[a].size() < 2 || keeps[b].size() < 2) continue;
     std::uint8_t to_a = 0, to_b = 0;
     const int na = plan(a, to_a), nb = plan(b, to_b);
-    if (na < 0 || nb < 0) continue;
+    // Both ends on the interface first (counting hexes): the level sets only for those edges.
+    if (na < 0 || nb < 0 || !along_curve(m.points[a], m.points[b], keeps[a], keeps[b], levels, cos_limit)) continue;
     const Index v = na <= nb ? a : b;
     const std::uint8_t to = na <= nb ? to_a : to_b;
     for (Index k = inc.offsets[v]; k < inc.offsets[v + 1]; ++k) side[inc.ids[k]] = to, locked[inc.ids[k]] = 1;

@@ -99,7 +99,7 @@ std::size_t unreachable_to_one_side(const HexMesh& m, const Incidence& inc, cons
 // An edge is on the curve when its midpoint is on both surfaces (within a quarter of its length;
 // not an edge across a patch between two branches of the curve). Returns how many ends moved.
 std::size_t doubled_curve_ends(const HexMesh& m, const std::vector<contour::LevelSet>& levels, const Incidence& inc,
-                               const std::vector<std::array<Index, 2>>& edges, const std::vector<Keeps>& keeps, double cos_limit, std::vector<std::uint8_t>& side,
-                               std::vector<std::uint8_t>& locked);
+                               const std::vector<std::array<Index, 2>>& edges, const std::vector<Keeps>& keeps,
+                               double cos_limit, std::vector<std::uint8_t>& side, std::vector<std::uint8_t>& locked);
 
 }  // namespace isohex::internal
